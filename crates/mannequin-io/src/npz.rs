@@ -1,0 +1,178 @@
+//! NumPy `.npz` archives: a zip file whose entries are `<key>.npy` arrays.
+
+use std::collections::BTreeMap;
+use std::io::{Cursor, Read, Write};
+use std::path::{Path, PathBuf};
+
+use crate::atomic::write_atomic;
+use crate::error::IoError;
+use crate::npy::{NpyArray, parse_npy, write_npy};
+
+/// All arrays of one `.npz` file, decoded eagerly, with the file name kept for errors.
+#[derive(Debug, Clone)]
+pub struct Npz {
+    pub path: PathBuf,
+    arrays: BTreeMap<String, NpyArray>,
+}
+
+impl Npz {
+    /// Reads and decodes every array in the archive.
+    pub fn read(path: impl AsRef<Path>) -> Result<Self, IoError> {
+        let path = path.as_ref().to_path_buf();
+        let bytes = std::fs::read(&path).map_err(|source| IoError::Io { path: path.clone(), source })?;
+        Self::from_bytes(path, &bytes)
+    }
+
+    /// Decodes an archive held in memory; `path` is used only in error messages.
+    pub fn from_bytes(path: PathBuf, bytes: &[u8]) -> Result<Self, IoError> {
+        let archive_err = |reason: String| IoError::Archive { path: path.clone(), reason };
+        let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| archive_err(e.to_string()))?;
+        let mut arrays = BTreeMap::new();
+        for i in 0..zip.len() {
+            let mut entry = zip.by_index(i).map_err(|e| archive_err(e.to_string()))?;
+            let name = entry.name().to_string();
+            let key = name.strip_suffix(".npy").unwrap_or(&name).to_string();
+            // Reject entries that claim more than the archive could possibly inflate to,
+            // so a corrupt size field cannot trigger a huge allocation.
+            let cap = (entry.size() as usize).min(bytes.len().saturating_mul(1100).max(1 << 20));
+            let mut buf = Vec::with_capacity(cap);
+            entry.read_to_end(&mut buf).map_err(|e| archive_err(format!("entry '{name}': {e}")))?;
+            let array = parse_npy(&buf).map_err(|e| IoError::Field {
+                path: path.clone(),
+                key: key.clone(),
+                reason: e.to_string(),
+            })?;
+            arrays.insert(key, array);
+        }
+        Ok(Self { path, arrays })
+    }
+
+    pub fn keys(&self) -> impl Iterator<Item = &str> {
+        self.arrays.keys().map(String::as_str)
+    }
+
+    pub fn contains(&self, key: &str) -> bool {
+        self.arrays.contains_key(key)
+    }
+
+    pub fn get(&self, key: &str) -> Option<&NpyArray> {
+        self.arrays.get(key)
+    }
+
+    /// The array under `key`, or an error that lists the keys that are there.
+    pub fn require(&self, key: &str) -> Result<&NpyArray, IoError> {
+        self.arrays.get(key).ok_or_else(|| IoError::MissingKey {
+            path: self.path.clone(),
+            key: key.to_string(),
+            present: self.keys().collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// An error about `key` in this file.
+    pub fn field_error(&self, key: &str, reason: impl Into<String>) -> IoError {
+        IoError::Field { path: self.path.clone(), key: key.to_string(), reason: reason.into() }
+    }
+
+    /// The array under `key` as f64, checking its shape against `expected`
+    /// (`None` entries match any size).
+    pub fn f64_with_shape(&self, key: &str, expected: &[Option<usize>]) -> Result<(Vec<usize>, Vec<f64>), IoError> {
+        let a = self.require(key)?;
+        check_shape(self, key, &a.shape, expected)?;
+        let v = a
+            .to_f64()
+            .ok_or_else(|| self.field_error(key, format!("expected numbers, found dtype {}", a.dtype_name())))?;
+        Ok((a.shape.clone(), v))
+    }
+}
+
+fn shape_text(expected: &[Option<usize>]) -> String {
+    let dims: Vec<String> = expected.iter().map(|d| d.map_or("*".into(), |n| n.to_string())).collect();
+    format!("({})", dims.join(", "))
+}
+
+fn check_shape(npz: &Npz, key: &str, shape: &[usize], expected: &[Option<usize>]) -> Result<(), IoError> {
+    let ok = shape.len() == expected.len() && shape.iter().zip(expected).all(|(s, e)| e.is_none_or(|e| e == *s));
+    if ok {
+        Ok(())
+    } else {
+        Err(npz.field_error(key, format!("expected shape {}, found {:?}", shape_text(expected), shape)))
+    }
+}
+
+/// Collects arrays and writes them as one `.npz` archive, atomically.
+#[derive(Debug, Default)]
+pub struct NpzWriter {
+    arrays: Vec<(String, NpyArray)>,
+}
+
+impl NpzWriter {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn add(&mut self, key: &str, array: NpyArray) -> &mut Self {
+        self.arrays.push((key.to_string(), array));
+        self
+    }
+
+    /// The archive bytes (deflate-compressed entries, as `numpy.savez_compressed` writes).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+        let opts = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .large_file(false);
+        for (key, array) in &self.arrays {
+            // Writing into memory cannot fail except on allocation failure.
+            zip.start_file(format!("{key}.npy"), opts).expect("in-memory zip entry");
+            zip.write_all(&write_npy(array)).expect("in-memory zip write");
+        }
+        zip.finish().expect("in-memory zip finish").into_inner()
+    }
+
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<(), IoError> {
+        let path = path.as_ref();
+        write_atomic(path, &self.to_bytes()).map_err(|source| IoError::Io { path: path.to_path_buf(), source })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> NpzWriter {
+        let mut w = NpzWriter::new();
+        w.add("a", NpyArray::f32(vec![2, 2], vec![1.0, 2.0, 3.0, 4.0]));
+        w.add("b", NpyArray::i64(vec![3], vec![7, 8, 9]));
+        w
+    }
+
+    #[test]
+    fn round_trip() {
+        let npz = Npz::from_bytes("mem.npz".into(), &sample().to_bytes()).unwrap();
+        assert_eq!(npz.keys().collect::<Vec<_>>(), vec!["a", "b"]);
+        assert_eq!(npz.require("b").unwrap().to_i64().unwrap(), vec![7, 8, 9]);
+    }
+
+    #[test]
+    fn missing_key_names_file_and_key() {
+        let npz = Npz::from_bytes("model.npz".into(), &sample().to_bytes()).unwrap();
+        let msg = npz.require("weights").unwrap_err().to_string();
+        assert!(msg.contains("model.npz") && msg.contains("'weights'") && msg.contains("a, b"), "{msg}");
+    }
+
+    #[test]
+    fn wrong_shape_names_expected_shape() {
+        let npz = Npz::from_bytes("m.npz".into(), &sample().to_bytes()).unwrap();
+        let msg = npz.f64_with_shape("a", &[Some(3), None]).unwrap_err().to_string();
+        assert!(msg.contains("'a'") && msg.contains("(3, *)") && msg.contains("[2, 2]"), "{msg}");
+    }
+
+    #[test]
+    fn truncated_archive_is_an_error() {
+        let bytes = sample().to_bytes();
+        for cut in [0, 10, bytes.len() / 2, bytes.len() - 1] {
+            let err = Npz::from_bytes("t.npz".into(), &bytes[..cut]).unwrap_err();
+            assert!(err.to_string().starts_with("t.npz: "), "{err}");
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! Logging and progress display shared by every verb: `tracing` for logs, `indicatif` for bars,
+//! and a closing line with wall time and peak memory for long jobs.
+
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+pub fn init_logging(verbose: u8) {
+    let default = match verbose {
+        0 => "info",
+        1 => "debug",
+        _ => "trace",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .without_time()
+        .init();
+}
+
+/// A progress bar for `len` steps of work, labelled `what`.
+pub fn bar(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} {per_sec} eta {eta}")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+/// Peak resident memory of this process in MiB, where the OS reports it.
+fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// Reports the wall time and peak memory of a job when dropped.
+pub struct JobTimer {
+    what: String,
+    start: Instant,
+}
+
+impl JobTimer {
+    pub fn start(what: &str) -> Self {
+        Self { what: what.to_string(), start: Instant::now() }
+    }
+}
+
+impl Drop for JobTimer {
+    fn drop(&mut self) {
+        let secs = self.start.elapsed().as_secs_f64();
+        match peak_memory_mib() {
+            Some(mib) => tracing::info!("{} took {secs:.2} s, peak memory {mib:.0} MiB", self.what),
+            None => tracing::info!("{} took {secs:.2} s", self.what),
+        }
+    }
+}
