@@ -1,0 +1,80 @@
+//! The triangle mesh every Mannequin crate exchanges.
+
+/// Texture coordinates with their own per-corner indexing, as OBJ and MakeHuman store them:
+/// a seam vertex has one position but several UVs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UvLayout {
+    /// UV coordinates, (u, v) with v up, as in OBJ.
+    pub coords: Vec<[f32; 2]>,
+    /// For each triangle, the indices of its three corners into `coords`.
+    pub faces: Vec<[u32; 3]>,
+}
+
+/// An indexed triangle mesh in metres.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TriMesh {
+    pub positions: Vec<[f32; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    /// Optional texture coordinates, one corner triple per face.
+    pub uv: Option<UvLayout>,
+    /// Optional per-vertex colour in [0, 1].
+    pub colors: Option<Vec<[f32; 3]>>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("face {face} refers to vertex {index}, but the mesh has {count} vertices")]
+    FaceIndex { face: usize, index: u32, count: usize },
+    #[error("the UV layout has {uv_faces} faces but the mesh has {faces}")]
+    UvFaceCount { uv_faces: usize, faces: usize },
+    #[error("UV face {face} refers to coordinate {index}, but there are {count}")]
+    UvIndex { face: usize, index: u32, count: usize },
+    #[error("{count} colours for {vertices} vertices")]
+    ColorCount { count: usize, vertices: usize },
+    #[error("vertex {vertex} is not finite")]
+    NonFinite { vertex: usize },
+}
+
+impl TriMesh {
+    pub fn new(positions: Vec<[f32; 3]>, faces: Vec<[u32; 3]>) -> Self {
+        Self { positions, faces, uv: None, colors: None }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// Checks that every index is in range and every position is finite.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        let n = self.positions.len();
+        for (face, tri) in self.faces.iter().enumerate() {
+            if let Some(&index) = tri.iter().find(|&&i| i as usize >= n) {
+                return Err(MeshError::FaceIndex { face, index, count: n });
+            }
+        }
+        if let Some(vertex) = self.positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(MeshError::NonFinite { vertex });
+        }
+        if let Some(uv) = &self.uv {
+            if uv.faces.len() != self.faces.len() {
+                return Err(MeshError::UvFaceCount { uv_faces: uv.faces.len(), faces: self.faces.len() });
+            }
+            let m = uv.coords.len();
+            for (face, tri) in uv.faces.iter().enumerate() {
+                if let Some(&index) = tri.iter().find(|&&i| i as usize >= m) {
+                    return Err(MeshError::UvIndex { face, index, count: m });
+                }
+            }
+        }
+        if let Some(c) = &self.colors
+            && c.len() != n
+        {
+            return Err(MeshError::ColorCount { count: c.len(), vertices: n });
+        }
+        Ok(())
+    }
+}
