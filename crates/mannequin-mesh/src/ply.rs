@@ -1,0 +1,473 @@
+//! Polygon File Format (`.ply`) for triangle meshes: ASCII and binary (little or big endian)
+//! reading, binary little-endian writing.
+//!
+//! Reads the `vertex` element's `x y z`, optional `nx ny nz` and `red green blue` (integer
+//! colours are scaled from their type's range to [0, 1]), and the `face` element's
+//! `vertex_indices` (or `vertex_index`) list; polygons are split into triangle fans. Every other
+//! element and property is skipped, so files from trimesh, MeshLab or Blender load as they are.
+
+use std::path::Path;
+
+use crate::{MeshFileError, TriMesh};
+
+/// A mesh read from PLY, with the per-vertex normals the file carried, if any.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlyMesh {
+    pub mesh: TriMesh,
+    pub normals: Option<Vec<[f32; 3]>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(name: &str) -> Option<Self> {
+        Some(match name {
+            "char" | "int8" => Self::I8,
+            "uchar" | "uint8" => Self::U8,
+            "short" | "int16" => Self::I16,
+            "ushort" | "uint16" => Self::U16,
+            "int" | "int32" => Self::I32,
+            "uint" | "uint32" => Self::U32,
+            "float" | "float32" => Self::F32,
+            "double" | "float64" => Self::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::I32 | Self::U32 | Self::F32 => 4,
+            Self::F64 => 8,
+        }
+    }
+
+    /// The value that an integer colour channel of this type takes at full intensity.
+    fn colour_max(self) -> f64 {
+        match self {
+            Self::U8 | Self::I8 => 255.0,
+            Self::U16 | Self::I16 => 65535.0,
+            Self::I32 | Self::U32 => u32::MAX as f64,
+            Self::F32 | Self::F64 => 1.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Property {
+    Scalar { name: String, ty: Scalar },
+    List { name: String, count: Scalar, item: Scalar },
+}
+
+impl Property {
+    fn name(&self) -> &str {
+        match self {
+            Self::Scalar { name, .. } | Self::List { name, .. } => name,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Element {
+    name: String,
+    count: usize,
+    properties: Vec<Property>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Format {
+    Ascii,
+    Binary { big_endian: bool },
+}
+
+struct Header {
+    format: Format,
+    elements: Vec<Element>,
+    /// Byte offset where the body starts.
+    body: usize,
+}
+
+/// Where in the file something is wrong, and what was expected there.
+struct Problem {
+    at: String,
+    expected: String,
+}
+
+fn bad(at: impl Into<String>, expected: impl Into<String>) -> Problem {
+    Problem { at: at.into(), expected: expected.into() }
+}
+
+fn parse_header(bytes: &[u8]) -> Result<Header, Problem> {
+    if !bytes.starts_with(b"ply") {
+        return Err(bad("start", "the 'ply' magic (this is not a PLY file)"));
+    }
+    let end_tag = b"end_header";
+    let pos = bytes
+        .windows(end_tag.len())
+        .position(|w| w == end_tag)
+        .ok_or_else(|| bad("header", "an 'end_header' line"))?;
+    let mut body = pos + end_tag.len();
+    // The header ends with "end_header" followed by one line break (\n or \r\n).
+    if bytes.get(body) == Some(&b'\r') {
+        body += 1;
+    }
+    if bytes.get(body) == Some(&b'\n') {
+        body += 1;
+    }
+    let text = std::str::from_utf8(&bytes[..pos]).map_err(|_| bad("header", "text"))?;
+    let mut format = None;
+    let mut elements: Vec<Element> = Vec::new();
+    for line in text.lines().skip(1) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            [] | ["comment", ..] | ["obj_info", ..] => {}
+            ["format", f, _version] => {
+                format = Some(match *f {
+                    "ascii" => Format::Ascii,
+                    "binary_little_endian" => Format::Binary { big_endian: false },
+                    "binary_big_endian" => Format::Binary { big_endian: true },
+                    _ => return Err(bad(format!("header line '{line}'"), "ascii or binary_*_endian")),
+                })
+            }
+            ["element", name, count] => elements.push(Element {
+                name: name.to_string(),
+                count: count
+                    .parse()
+                    .map_err(|_| bad(format!("header line '{line}'"), "a whole element count"))?,
+                properties: Vec::new(),
+            }),
+            ["property", "list", count, item, name] => {
+                let ty = |t: &str| {
+                    Scalar::parse(t).ok_or_else(|| bad(format!("header line '{line}'"), "a PLY type"))
+                };
+                let element = elements
+                    .last_mut()
+                    .ok_or_else(|| bad(format!("header line '{line}'"), "an element first"))?;
+                element.properties.push(Property::List {
+                    name: name.to_string(),
+                    count: ty(count)?,
+                    item: ty(item)?,
+                });
+            }
+            ["property", ty, name] => {
+                let ty =
+                    Scalar::parse(ty).ok_or_else(|| bad(format!("header line '{line}'"), "a PLY type"))?;
+                let element = elements
+                    .last_mut()
+                    .ok_or_else(|| bad(format!("header line '{line}'"), "an element first"))?;
+                element.properties.push(Property::Scalar { name: name.to_string(), ty });
+            }
+            _ => return Err(bad(format!("header line '{line}'"), "format, element, property or comment")),
+        }
+    }
+    Ok(Header { format: format.ok_or_else(|| bad("header", "a 'format' line"))?, elements, body })
+}
+
+/// Sequential reader of scalar values from the body, in either encoding.
+struct Body<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    format: Format,
+}
+
+impl Body<'_> {
+    fn next_binary(&mut self, ty: Scalar, big_endian: bool) -> Result<f64, &'static str> {
+        let n = ty.size();
+        let raw = self.bytes.get(self.at..self.at + n).ok_or("more data (the file ends early)")?;
+        self.at += n;
+        let mut b = [0u8; 8];
+        b[..n].copy_from_slice(raw);
+        if big_endian {
+            b[..n].reverse();
+        }
+        Ok(match ty {
+            Scalar::I8 => b[0] as i8 as f64,
+            Scalar::U8 => b[0] as f64,
+            Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+            Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+            Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F64 => f64::from_le_bytes(b),
+        })
+    }
+
+    fn next_ascii(&mut self) -> Result<f64, &'static str> {
+        let rest = &self.bytes[self.at..];
+        let start =
+            rest.iter().position(|c| !c.is_ascii_whitespace()).ok_or("more data (the file ends early)")?;
+        let len = rest[start..].iter().position(|c| c.is_ascii_whitespace()).unwrap_or(rest.len() - start);
+        self.at += start + len;
+        let word = std::str::from_utf8(&rest[start..start + len]).map_err(|_| "a number")?;
+        word.parse::<f64>().map_err(|_| "a number")
+    }
+
+    fn next(&mut self, ty: Scalar) -> Result<f64, &'static str> {
+        match self.format {
+            Format::Ascii => self.next_ascii(),
+            Format::Binary { big_endian } => self.next_binary(ty, big_endian),
+        }
+    }
+}
+
+/// Where each property we use sits in a vertex record.
+#[derive(Default)]
+struct VertexSlots {
+    position: [Option<usize>; 3],
+    normal: [Option<usize>; 3],
+    color: [Option<(usize, Scalar)>; 3],
+}
+
+fn vertex_slots(element: &Element) -> Result<VertexSlots, Problem> {
+    let mut s = VertexSlots::default();
+    for (i, p) in element.properties.iter().enumerate() {
+        let Property::Scalar { name, ty } = p else { continue };
+        match name.as_str() {
+            "x" => s.position[0] = Some(i),
+            "y" => s.position[1] = Some(i),
+            "z" => s.position[2] = Some(i),
+            "nx" => s.normal[0] = Some(i),
+            "ny" => s.normal[1] = Some(i),
+            "nz" => s.normal[2] = Some(i),
+            "red" | "r" => s.color[0] = Some((i, *ty)),
+            "green" | "g" => s.color[1] = Some((i, *ty)),
+            "blue" | "b" => s.color[2] = Some((i, *ty)),
+            _ => {}
+        }
+    }
+    if s.position.iter().any(Option::is_none) {
+        return Err(bad("header, element vertex", "properties x, y and z"));
+    }
+    Ok(s)
+}
+
+fn parse_body(header: &Header, bytes: &[u8]) -> Result<PlyMesh, Problem> {
+    let mut body = Body { bytes, at: header.body, format: header.format };
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut colors = Vec::new();
+    let mut faces = Vec::new();
+    let mut has_normals = false;
+    let mut has_colors = false;
+    let mut record = Vec::new();
+    for element in &header.elements {
+        let slots = if element.name == "vertex" { Some(vertex_slots(element)?) } else { None };
+        if let Some(s) = &slots {
+            has_normals = s.normal.iter().all(Option::is_some);
+            has_colors = s.color.iter().all(Option::is_some);
+            // The header's count is untrusted: never reserve more than the file could hold.
+            positions.reserve(element.count.min(bytes.len() / 12));
+        }
+        let face_list = (element.name == "face")
+            .then(|| {
+                element.properties.iter().position(|p| {
+                    matches!(p, Property::List { .. })
+                        && matches!(p.name(), "vertex_indices" | "vertex_index")
+                })
+            })
+            .flatten();
+        if element.name == "face" && face_list.is_none() {
+            return Err(bad("header, element face", "a 'vertex_indices' list property"));
+        }
+        for row in 0..element.count {
+            record.clear();
+            for (pi, p) in element.properties.iter().enumerate() {
+                let at = || format!("element {} {row}, property {}", element.name, p.name());
+                match p {
+                    Property::Scalar { ty, .. } => record.push(body.next(*ty).map_err(|e| bad(at(), e))?),
+                    Property::List { count, item, .. } => {
+                        let n = body.next(*count).map_err(|e| bad(at(), e))?;
+                        if n < 0.0 || n.fract() != 0.0 {
+                            return Err(bad(at(), "a whole list length"));
+                        }
+                        let mut items = Vec::with_capacity((n as usize).min(64));
+                        for _ in 0..n as usize {
+                            items.push(body.next(*item).map_err(|e| bad(at(), e))?);
+                        }
+                        if Some(pi) == face_list {
+                            push_fan(&items, &at(), &mut faces)?;
+                        }
+                        record.push(f64::NAN);
+                    }
+                }
+            }
+            if let Some(s) = &slots {
+                let get = |slot: [Option<usize>; 3]| slot.map(|i| record[i.unwrap_or(0)] as f32);
+                positions.push(get(s.position));
+                if has_normals {
+                    normals.push(get(s.normal));
+                }
+                if has_colors {
+                    colors.push(s.color.map(|c| {
+                        let (i, ty) = c.unwrap_or((0, Scalar::F32));
+                        (record[i] / ty.colour_max()) as f32
+                    }));
+                }
+            }
+        }
+    }
+    let mut mesh = TriMesh::new(positions, faces);
+    mesh.colors = has_colors.then_some(colors);
+    Ok(PlyMesh { mesh, normals: has_normals.then_some(normals) })
+}
+
+/// Splits a polygon into the triangle fan (v0, vi, vi+1).
+fn push_fan(items: &[f64], at: &str, faces: &mut Vec<[u32; 3]>) -> Result<(), Problem> {
+    if items.len() < 3 {
+        return Err(bad(at, format!("at least 3 corners, found {}", items.len())));
+    }
+    let idx = |x: f64| {
+        (x >= 0.0 && x.fract() == 0.0 && x <= u32::MAX as f64)
+            .then_some(x as u32)
+            .ok_or_else(|| bad(at, format!("a vertex index, found {x}")))
+    };
+    for k in 1..items.len() - 1 {
+        faces.push([idx(items[0])?, idx(items[k])?, idx(items[k + 1])?]);
+    }
+    Ok(())
+}
+
+/// Parses PLY bytes; `path` is used only in error messages.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh, MeshFileError> {
+    let err = |p: Problem| MeshFileError::format(path, p.at, p.expected);
+    let header = parse_header(bytes).map_err(err)?;
+    let ply = parse_body(&header, bytes).map_err(err)?;
+    ply.mesh.validate().map_err(|e| MeshFileError::invalid(path, e))?;
+    Ok(ply)
+}
+
+pub fn read(path: impl AsRef<Path>) -> Result<PlyMesh, MeshFileError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|e| MeshFileError::io(path, e))?;
+    parse(path, &bytes)
+}
+
+/// Binary little-endian PLY: float positions, optional float normals, optional uchar colours,
+/// and faces as `uchar` count + `int` indices (the layout trimesh and MeshLab write).
+pub fn to_bytes(mesh: &TriMesh, normals: Option<&[[f32; 3]]>) -> Vec<u8> {
+    let mut header = String::from("ply\nformat binary_little_endian 1.0\ncomment written by Mannequin\n");
+    header += &format!("element vertex {}\n", mesh.positions.len());
+    header += "property float x\nproperty float y\nproperty float z\n";
+    if normals.is_some() {
+        header += "property float nx\nproperty float ny\nproperty float nz\n";
+    }
+    if mesh.colors.is_some() {
+        header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    }
+    header +=
+        &format!("element face {}\nproperty list uchar int vertex_indices\nend_header\n", mesh.faces.len());
+    let per_vertex = 12 + normals.map_or(0, |_| 12) + mesh.colors.as_ref().map_or(0, |_| 3);
+    let mut out =
+        Vec::with_capacity(header.len() + per_vertex * mesh.positions.len() + 13 * mesh.faces.len());
+    out.extend_from_slice(header.as_bytes());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        p.iter().for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
+        if let Some(n) = normals {
+            n[i].iter().for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
+        }
+        if let Some(colors) = &mesh.colors {
+            out.extend(colors[i].map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8));
+        }
+    }
+    for f in &mesh.faces {
+        out.push(3);
+        f.iter().for_each(|&i| out.extend_from_slice(&(i as i32).to_le_bytes()));
+    }
+    out
+}
+
+/// Writes a binary PLY atomically. `normals`, when given, must have one entry per vertex.
+pub fn write(
+    path: impl AsRef<Path>,
+    mesh: &TriMesh,
+    normals: Option<&[[f32; 3]]>,
+) -> Result<(), MeshFileError> {
+    let path = path.as_ref();
+    mesh.validate().map_err(|e| MeshFileError::invalid(path, e))?;
+    if let Some(n) = normals.filter(|n| n.len() != mesh.positions.len()) {
+        let expected = format!("one normal per vertex ({}), given {}", mesh.positions.len(), n.len());
+        return Err(MeshFileError::format(path, "normals", expected));
+    }
+    let bytes = to_bytes(mesh, normals);
+    mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> TriMesh {
+        let mut m = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.5], [0.0, 1.0, -0.25]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        );
+        m.colors = Some(vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]]);
+        m
+    }
+
+    #[test]
+    fn binary_round_trip_keeps_everything() {
+        let m = quad();
+        let n = vec![[0.0, 0.0, 1.0]; 4];
+        let back = parse(Path::new("q.ply"), &to_bytes(&m, Some(&n))).unwrap();
+        assert_eq!(back.mesh, m);
+        assert_eq!(back.normals.unwrap(), n);
+    }
+
+    /// A hand-written ASCII file with a quad face, an extra property and an extra element.
+    #[test]
+    fn ascii_polygons_become_fans_and_unknown_fields_are_skipped() {
+        let text = "ply\nformat ascii 1.0\ncomment hand made\nelement vertex 4\nproperty double x\n\
+                    property double y\nproperty double z\nproperty float quality\n\
+                    element face 1\nproperty list uchar uint vertex_indices\nproperty uchar flags\n\
+                    element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n\
+                    0 0 0 9\n1 0 0 9\n1 1 0 9\n0 1 0 9\n4 0 1 2 3 7\n0 1\n";
+        let m = parse(Path::new("a.ply"), text.as_bytes()).unwrap();
+        assert_eq!(m.mesh.positions[2], [1.0, 1.0, 0.0]);
+        assert_eq!(m.mesh.faces, vec![[0, 1, 2], [0, 2, 3]]);
+        assert!(m.normals.is_none() && m.mesh.colors.is_none());
+    }
+
+    #[test]
+    fn big_endian_is_read() {
+        let mut b =
+            b"ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                      property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                .to_vec();
+        for v in [0.0f32, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.0, 0.0] {
+            b.extend_from_slice(&v.to_be_bytes());
+        }
+        b.push(3);
+        for i in [0i32, 1, 2] {
+            b.extend_from_slice(&i.to_be_bytes());
+        }
+        let m = parse(Path::new("be.ply"), &b).unwrap();
+        assert_eq!(m.mesh.positions[1], [2.0, 0.0, 0.0]);
+        assert_eq!(m.mesh.positions[2], [0.0, 3.0, 0.0]);
+        assert_eq!(m.mesh.faces, vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn truncated_and_bad_files_name_the_file() {
+        let bytes = to_bytes(&quad(), None);
+        let err = parse(Path::new("cut.ply"), &bytes[..bytes.len() - 3]).unwrap_err().to_string();
+        assert!(err.starts_with("cut.ply: ") && err.contains("ends early"), "{err}");
+        let mut bad = quad();
+        bad.faces[1][2] = 9;
+        let err = parse(Path::new("idx.ply"), &to_bytes(&bad, None)).unwrap_err().to_string();
+        assert!(err.contains("idx.ply") && err.contains("vertex 9"), "{err}");
+        let err = parse(Path::new("x.ply"), b"plx\n").unwrap_err().to_string();
+        assert!(err.contains("magic"), "{err}");
+    }
+}
