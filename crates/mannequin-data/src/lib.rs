@@ -1,1 +1,26 @@
-//! placeholder
+//! Datasets, ground truth and metrics: the PeopleSnapshot-layout reader and writer, a CPU mesh
+//! rasterizer for ground-truth images, synthetic subjects, and the metrics the papers report.
+
+pub mod camera;
+pub mod dataset;
+pub mod error;
+pub mod evaluation;
+pub mod image;
+pub mod layout;
+pub mod maps;
+pub mod mesh_raster;
+pub mod metrics;
+pub mod poses;
+pub mod rng;
+pub mod splits;
+pub mod synth;
+pub mod writer;
+
+pub use camera::Camera;
+pub use dataset::{Cameras, Dataset, Frame, Split};
+pub use error::DataError;
+pub use image::{Image, Mask};
+pub use maps::{DepthMap, NormalMap};
+pub use poses::Poses;
+pub use splits::{SplitRange, Splits, standard_splits};
+pub use writer::DatasetWriter;

@@ -1,0 +1,222 @@
+//! Frame-by-frame comparison of a predicted folder with a ground-truth dataset folder.
+//!
+//! Frames are matched by image name (`images/image_NNNN.png` present in both). The ground
+//! truth is composited on the stated background with its mask; the prediction is taken as
+//! rendered. Where both folders hold normal maps (`normals/`) or meshes (`meshes/`), normal and
+//! geometry metrics are added. A ground truth at an integer multiple of the prediction's size
+//! is box-downscaled to it first (PeopleSnapshot's 1080² against 540² renders).
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::error::DataError;
+use crate::image::Image;
+use crate::layout;
+use crate::maps::{NormalMap, read_mask_npy};
+use crate::metrics::geometry::{GeometryMetrics, geometry_metrics};
+use crate::metrics::lpips::Lpips;
+use crate::metrics::normal_error::normal_error;
+use crate::metrics::{psnr::psnr, ssim::ssim};
+
+pub struct EvalOptions {
+    pub background: [f32; 3],
+    pub lpips: Option<Lpips>,
+    /// Surface samples per mesh for the geometry metrics.
+    pub samples: usize,
+    pub seed: u64,
+}
+
+/// The scores of one frame; `None` where the inputs for a metric are missing.
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameScores {
+    pub frame: usize,
+    pub psnr: f64,
+    pub ssim: f64,
+    pub lpips: Option<f64>,
+    pub normal_mse_x1e3: Option<f64>,
+    pub normal_angle_deg: Option<f64>,
+    pub chamfer_cm: Option<f64>,
+    pub p2s_cm: Option<f64>,
+    pub normal_consistency: Option<f64>,
+}
+
+/// Means over frames (over the frames that have the metric, for the optional ones).
+#[derive(Debug, Clone, Serialize)]
+pub struct EvalSummary {
+    pub pred: PathBuf,
+    pub gt: PathBuf,
+    pub background: [f32; 3],
+    pub gt_downscale: usize,
+    pub frames: usize,
+    pub psnr: f64,
+    pub ssim: f64,
+    pub lpips: Option<f64>,
+    pub normal_mse_x1e3: Option<f64>,
+    pub normal_angle_deg: Option<f64>,
+    pub chamfer_cm: Option<f64>,
+    pub p2s_cm: Option<f64>,
+    pub normal_consistency: Option<f64>,
+    pub per_frame: Vec<FrameScores>,
+}
+
+/// Frame numbers of `images/image_NNNN.png` in `root`, sorted.
+fn image_frames(root: &Path) -> Result<Vec<usize>, DataError> {
+    let dir = root.join(layout::IMAGES);
+    let mut frames = Vec::new();
+    for entry in std::fs::read_dir(&dir).map_err(|e| DataError::os(&dir, e))? {
+        let entry = entry.map_err(|e| DataError::os(&dir, e))?;
+        if let Some(n) = layout::frame_number(&entry.file_name().to_string_lossy(), "image", "png") {
+            frames.push(n);
+        }
+    }
+    frames.sort_unstable();
+    Ok(frames)
+}
+
+/// The frames both folders have, in order.
+pub fn matching_frames(pred: &Path, gt: &Path) -> Result<Vec<usize>, DataError> {
+    let gt_frames = image_frames(gt)?;
+    let common: Vec<usize> =
+        image_frames(pred)?.into_iter().filter(|f| gt_frames.binary_search(f).is_ok()).collect();
+    if common.is_empty() {
+        return Err(DataError::file(
+            pred.join(layout::IMAGES),
+            format!("no image_NNNN.png shares a name with {}", gt.join(layout::IMAGES).display()),
+        ));
+    }
+    Ok(common)
+}
+
+/// The integer factor from `pred`'s size to `gt`'s, or an error naming both files.
+fn downscale_factor(
+    pred: (usize, usize),
+    gt: (usize, usize),
+    pred_path: &Path,
+    gt_path: &Path,
+) -> Result<usize, DataError> {
+    let f = gt.0 / pred.0.max(1);
+    if f >= 1 && gt.0 == f * pred.0 && gt.1 == f * pred.1 {
+        return Ok(f);
+    }
+    Err(DataError::file(
+        pred_path,
+        format!(
+            "is {}×{} but {} is {}×{} (not an integer multiple)",
+            pred.0,
+            pred.1,
+            gt_path.display(),
+            gt.0,
+            gt.1
+        ),
+    ))
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    s / n as f64
+}
+
+fn mean_of(frames: &[FrameScores], get: impl Fn(&FrameScores) -> Option<f64>) -> Option<f64> {
+    let v: Vec<f64> = frames.iter().filter_map(get).collect();
+    (!v.is_empty()).then(|| mean(v.into_iter()))
+}
+
+/// Scores one frame.
+fn score_frame(
+    pred: &Path,
+    gt: &Path,
+    frame: usize,
+    opt: &EvalOptions,
+) -> Result<(FrameScores, usize), DataError> {
+    let (pred_path, gt_path) = (layout::image(pred, frame), layout::image(gt, frame));
+    let p = Image::read_png(&pred_path)?;
+    let g = Image::read_png(&gt_path)?;
+    let factor = downscale_factor((p.width, p.height), (g.width, g.height), &pred_path, &gt_path)?;
+    let mask_path = layout::mask(gt, frame);
+    let mask = read_mask_npy(&mask_path)?;
+    if (mask.width, mask.height) != (g.width, g.height) {
+        return Err(DataError::file(
+            mask_path,
+            format!("mask is {}×{}, image is {}×{}", mask.width, mask.height, g.width, g.height),
+        ));
+    }
+    let mut g = g.composite(&mask, opt.background);
+    if factor > 1 {
+        g = g.downscale(factor);
+    }
+    let lpips = opt.lpips.as_ref().map(|m| m.distance(&p, &g)).transpose()?;
+    let (pn_path, gn_path) = (layout::normal(pred, frame), layout::normal(gt, frame));
+    let normals = if pn_path.exists() && gn_path.exists() {
+        let pn = NormalMap::read_png(&pn_path)?;
+        let mut gn = NormalMap::read_png(&gn_path)?;
+        if factor > 1 {
+            gn = gn.downscale(factor);
+        }
+        if (pn.width, pn.height) != (gn.width, gn.height) {
+            return Err(DataError::file(
+                pn_path,
+                format!("normal map is {}×{}, ground truth {}×{}", pn.width, pn.height, gn.width, gn.height),
+            ));
+        }
+        Some(normal_error(&pn, &gn))
+    } else {
+        None
+    };
+    let (pm_path, gm_path) = (layout::mesh(pred, frame), layout::mesh(gt, frame));
+    let geometry: Option<GeometryMetrics> = if pm_path.exists() && gm_path.exists() {
+        let pm = mannequin_mesh::ply::read(&pm_path)?.mesh;
+        let gm = mannequin_mesh::ply::read(&gm_path)?.mesh;
+        Some(geometry_metrics(&pm, &gm, opt.samples, opt.seed))
+    } else {
+        None
+    };
+    Ok((
+        FrameScores {
+            frame,
+            psnr: psnr(&p, &g),
+            ssim: ssim(&p, &g),
+            lpips,
+            normal_mse_x1e3: normals.map(|n| n.mse_x1e3),
+            normal_angle_deg: normals.map(|n| n.angular_deg),
+            chamfer_cm: geometry.map(|m| m.chamfer_cm),
+            p2s_cm: geometry.map(|m| m.p2s_cm),
+            normal_consistency: geometry.map(|m| m.normal_consistency),
+        },
+        factor,
+    ))
+}
+
+/// Compares every matching frame; `on_frame` is called after each (for progress display).
+pub fn evaluate(
+    pred: &Path,
+    gt: &Path,
+    opt: &EvalOptions,
+    on_frame: &dyn Fn(&FrameScores),
+) -> Result<EvalSummary, DataError> {
+    let frames = matching_frames(pred, gt)?;
+    let mut per_frame = Vec::with_capacity(frames.len());
+    let mut gt_downscale = 1;
+    for &f in &frames {
+        let (scores, factor) = score_frame(pred, gt, f, opt)?;
+        gt_downscale = factor;
+        on_frame(&scores);
+        per_frame.push(scores);
+    }
+    Ok(EvalSummary {
+        pred: pred.to_path_buf(),
+        gt: gt.to_path_buf(),
+        background: opt.background,
+        gt_downscale,
+        frames: per_frame.len(),
+        psnr: mean(per_frame.iter().map(|s| s.psnr)),
+        ssim: mean(per_frame.iter().map(|s| s.ssim)),
+        lpips: mean_of(&per_frame, |s| s.lpips),
+        normal_mse_x1e3: mean_of(&per_frame, |s| s.normal_mse_x1e3),
+        normal_angle_deg: mean_of(&per_frame, |s| s.normal_angle_deg),
+        chamfer_cm: mean_of(&per_frame, |s| s.chamfer_cm),
+        p2s_cm: mean_of(&per_frame, |s| s.p2s_cm),
+        normal_consistency: mean_of(&per_frame, |s| s.normal_consistency),
+        per_frame,
+    })
+}

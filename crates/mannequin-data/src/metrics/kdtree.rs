@@ -1,0 +1,105 @@
+//! A 3-D k-d tree for exact nearest-neighbour queries: points sorted in place around median
+//! splits on the widest axis, searched depth-first with pruning on the splitting plane.
+
+use glam::DVec3;
+
+pub struct KdTree {
+    points: Vec<DVec3>,
+    /// `order[i]` is the input index of the point stored at tree position `i`.
+    order: Vec<u32>,
+    /// Splitting axis of the subtree whose median sits at each position (leaves unused).
+    axis: Vec<u8>,
+}
+
+const LEAF: usize = 8;
+
+impl KdTree {
+    pub fn new(points: &[DVec3]) -> Self {
+        let mut order: Vec<u32> = (0..points.len() as u32).collect();
+        let mut axis = vec![0u8; points.len()];
+        build(points, &mut order, &mut axis);
+        let sorted = order.iter().map(|&i| points[i as usize]).collect();
+        Self { points: sorted, order, axis }
+    }
+
+    /// The input index of the nearest point and its squared distance (`None` for an empty tree).
+    pub fn nearest(&self, q: DVec3) -> Option<(usize, f64)> {
+        if self.points.is_empty() {
+            return None;
+        }
+        let mut best = (usize::MAX, f64::INFINITY);
+        self.search(q, 0, self.points.len(), &mut best);
+        Some((self.order[best.0] as usize, best.1))
+    }
+
+    fn search(&self, q: DVec3, lo: usize, hi: usize, best: &mut (usize, f64)) {
+        if hi - lo <= LEAF {
+            for i in lo..hi {
+                let d = self.points[i].distance_squared(q);
+                if d < best.1 {
+                    *best = (i, d);
+                }
+            }
+            return;
+        }
+        let mid = lo + (hi - lo) / 2;
+        let ax = self.axis[mid] as usize;
+        let diff = q[ax] - self.points[mid][ax];
+        let d = self.points[mid].distance_squared(q);
+        if d < best.1 {
+            *best = (mid, d);
+        }
+        let (near, far) = if diff < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
+        self.search(q, near.0, near.1, best);
+        if diff * diff < best.1 {
+            self.search(q, far.0, far.1, best);
+        }
+    }
+}
+
+fn build(points: &[DVec3], order: &mut [u32], axis: &mut [u8]) {
+    if order.len() <= LEAF {
+        return;
+    }
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for &i in order.iter() {
+        lo = lo.min(points[i as usize]);
+        hi = hi.max(points[i as usize]);
+    }
+    let ext = hi - lo;
+    let ax = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&a, &b| points[a as usize][ax].total_cmp(&points[b as usize][ax]));
+    axis[mid] = ax as u8;
+    let (left, right) = order.split_at_mut(mid);
+    let (axis_left, axis_right) = axis.split_at_mut(mid);
+    build(points, left, axis_left);
+    build(points, &mut right[1..], &mut axis_right[1..]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_brute_force() {
+        let mut r = crate::rng::SplitMix64::new(5);
+        let mut pt = || DVec3::new(r.normal(), r.normal() * 0.3, r.uniform());
+        let points: Vec<DVec3> = (0..2000).map(|_| pt()).collect();
+        let tree = KdTree::new(&points);
+        for _ in 0..500 {
+            let q = pt() * 1.2;
+            let (i, d) = tree.nearest(q).unwrap();
+            let brute = points.iter().map(|p| p.distance_squared(q)).fold(f64::INFINITY, f64::min);
+            assert_eq!(d, brute);
+            assert_eq!(points[i].distance_squared(q), d);
+        }
+        assert!(KdTree::new(&[]).nearest(DVec3::ZERO).is_none());
+    }
+}

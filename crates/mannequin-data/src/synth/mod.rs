@@ -1,0 +1,219 @@
+//! Synthetic subjects whose every answer is known: a clothed, textured person from the default
+//! body, captured like PeopleSnapshot (one static camera, the person turning in an A-pose), with
+//! novel-view and novel-pose test sets, written in the dataset layout with ground-truth normals,
+//! depth and meshes (see `docs/dataset-format.md`, "Synthetic subjects").
+
+pub mod clothing;
+pub mod motion;
+pub mod scene;
+pub mod skirt;
+pub mod subject;
+pub mod texture;
+
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::camera::Camera;
+use crate::dataset::{Cameras, Frame};
+use crate::error::DataError;
+use crate::poses::{BODY_POSE_LEN, Poses};
+use crate::splits::{SplitRange, Splits};
+use crate::writer::DatasetWriter;
+use mannequin_body::BodyModel;
+use scene::{PosedSequence, Scene};
+use subject::Subject;
+
+/// Sizes of the generated dataset.
+#[derive(Debug, Clone, Serialize)]
+pub struct SynthOptions {
+    pub seed: u64,
+    /// Output images are `size × size`.
+    pub size: usize,
+    /// Ground truth is rendered at `supersample × size` and box-filtered down.
+    pub supersample: usize,
+    /// Frames of the turning capture; the first `train_frames` are the training split and the
+    /// rest the test split.
+    pub capture_frames: usize,
+    pub train_frames: usize,
+    /// Training poses re-rendered from each novel camera.
+    pub view_poses: usize,
+    /// Frames of each out-of-distribution motion.
+    pub motion_frames: usize,
+}
+
+impl Default for SynthOptions {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            size: 540,
+            supersample: 2,
+            capture_frames: 120,
+            train_frames: 96,
+            view_poses: 8,
+            motion_frames: 8,
+        }
+    }
+}
+
+impl SynthOptions {
+    /// Frames written in all, for progress display.
+    pub fn total_frames(&self) -> usize {
+        self.capture_frames + self.view_poses * scene::NOVEL_VIEWS + 4 * self.motion_frames
+    }
+
+    fn check(&self) -> Result<(), DataError> {
+        let ok = self.size >= 32
+            && self.supersample >= 1
+            && self.train_frames >= 1
+            && self.capture_frames > self.train_frames
+            && self.view_poses >= 1
+            && self.view_poses <= self.train_frames
+            && self.motion_frames >= 1;
+        if ok {
+            Ok(())
+        } else {
+            Err(DataError::Invalid(format!(
+                "synthetic capture needs size ≥ 32, supersample ≥ 1, 1 ≤ train frames < capture frames, \
+                 1 ≤ view poses ≤ train frames and motion frames ≥ 1; got {self:?}"
+            )))
+        }
+    }
+}
+
+/// What was generated, written to `subject.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SynthSummary {
+    pub options: SynthOptions,
+    pub subject: Subject,
+    pub vertices: usize,
+    pub faces: usize,
+    pub novel_view_cameras: Vec<&'static str>,
+    pub novel_pose_motions: Vec<&'static str>,
+}
+
+fn split_poses(betas: &[f32], poses72: &[f32], transl: &[[f32; 3]]) -> Poses {
+    let mut b = betas.to_vec();
+    b.resize(10.max(betas.len()), 0.0);
+    Poses {
+        betas: b,
+        global_orient: poses72.chunks_exact(72).map(|p| [p[0], p[1], p[2]]).collect(),
+        body_pose: poses72.chunks_exact(72).flat_map(|p| p[3..3 + BODY_POSE_LEN].to_vec()).collect(),
+        transl: transl.to_vec(),
+    }
+}
+
+fn one_split(name: &str, frames: usize) -> Splits {
+    [(name.to_string(), SplitRange::new(0, frames - 1, 1))].into()
+}
+
+/// Renders and writes every frame of `seq` under `writer`, one camera per frame.
+fn write_frames(
+    scene: &Scene,
+    seq: &PosedSequence,
+    cameras: &[Camera],
+    writer: &DatasetWriter,
+    supersample: usize,
+    on_frame: &(dyn Fn() + Sync),
+) -> Result<(), DataError> {
+    (0..seq.len()).into_par_iter().try_for_each(|i| {
+        let mesh = seq.mesh(scene, i);
+        let r = scene.render(&mesh, &cameras[i], supersample);
+        writer.write_frame(&Frame {
+            index: i,
+            image: r.color,
+            mask: r.mask,
+            normals: Some(r.normals),
+            depth: Some(r.depth),
+        })?;
+        writer.write_mesh(i, &mesh)?;
+        on_frame();
+        Ok(())
+    })
+}
+
+/// Generates the dataset under `out`: the capture at the root, `test/novel_view/` and
+/// `test/novel_pose/` beside it. Deterministic in `options`.
+pub fn generate(
+    model: &BodyModel,
+    out: &Path,
+    options: &SynthOptions,
+    on_frame: &(dyn Fn() + Sync),
+) -> Result<SynthSummary, DataError> {
+    options.check()?;
+    let subject = Subject::random(options.seed, model.num_betas().min(10));
+    let scene = Scene::new(model, &subject)?;
+    let mut rng = crate::rng::SplitMix64::new(options.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xCA97);
+
+    // The capture: one camera, the subject turning.
+    let capture_poses = motion::turning_a_pose(options.capture_frames, 1.25, &mut rng)?;
+    let capture = scene.pose(model, &capture_poses)?;
+    let camera = scene.framing_camera(&capture, scene::TRAIN_VIEW, options.size);
+    let root = DatasetWriter::new(out);
+    root.write_cameras(&Cameras::Static(camera.clone()))?;
+    let (train, test) = (options.train_frames, options.capture_frames);
+    root.write_splits(
+        &[
+            ("train".to_string(), SplitRange::new(0, train - 1, 1)),
+            ("val".to_string(), SplitRange::new(train, train, 1)),
+            ("test".to_string(), SplitRange::new(train, test - 1, 1)),
+        ]
+        .into(),
+    )?;
+    let all = split_poses(&subject.betas, &capture_poses, &capture.transl);
+    root.write_poses("train", &all.select(&(0..train).collect::<Vec<_>>()))?;
+    root.write_poses("val", &all.select(&[train]))?;
+    root.write_poses("test", &all.select(&(train..test).collect::<Vec<_>>()))?;
+    write_frames(
+        &scene,
+        &capture,
+        &vec![camera.clone(); capture.len()],
+        &root,
+        options.supersample,
+        on_frame,
+    )?;
+
+    // Novel views: evenly spaced training poses from each of the novel cameras.
+    let picks: Vec<usize> = (0..options.view_poses).map(|k| k * train / options.view_poses).collect();
+    let view_frames: Vec<usize> = (0..scene::NOVEL_VIEWS).flat_map(|_| picks.iter().copied()).collect();
+    let view_poses: Vec<f32> =
+        view_frames.iter().flat_map(|&f| capture_poses[72 * f..72 * f + 72].to_vec()).collect();
+    let views = scene.pose(model, &view_poses)?;
+    let view_cameras: Vec<Camera> = (0..scene::NOVEL_VIEWS)
+        .flat_map(|v| {
+            let cam = scene.framing_camera(&capture, scene::NOVEL_VIEW_SETUPS[v].1, options.size);
+            vec![cam; picks.len()]
+        })
+        .collect();
+    let nv = DatasetWriter::new(out.join("test/novel_view"));
+    nv.write_cameras(&Cameras::PerFrame(view_cameras.clone()))?;
+    nv.write_splits(&one_split("test", views.len()))?;
+    nv.write_poses("test", &split_poses(&subject.betas, &view_poses, &views.transl))?;
+    write_frames(&scene, &views, &view_cameras, &nv, options.supersample, on_frame)?;
+
+    // Novel poses: out-of-distribution motions from the training camera.
+    let (motion_names, novel_poses) = motion::novel_poses(options.motion_frames, &mut rng)?;
+    let novel = scene.pose(model, &novel_poses)?;
+    let np = DatasetWriter::new(out.join("test/novel_pose"));
+    np.write_cameras(&Cameras::Static(camera.clone()))?;
+    np.write_splits(&one_split("test", novel.len()))?;
+    np.write_poses("test", &split_poses(&subject.betas, &novel_poses, &novel.transl))?;
+    write_frames(&scene, &novel, &vec![camera; novel.len()], &np, options.supersample, on_frame)?;
+
+    scene.texture.write_png(&out.join("texture.png"))?;
+    let mut motions: Vec<&'static str> = motion_names;
+    motions.dedup();
+    let summary = SynthSummary {
+        options: options.clone(),
+        subject,
+        vertices: scene.positions.len(),
+        faces: scene.faces.len(),
+        novel_view_cameras: scene::NOVEL_VIEW_SETUPS.iter().map(|s| s.0).collect(),
+        novel_pose_motions: motions,
+    };
+    let path = out.join("subject.json");
+    let text = serde_json::to_string_pretty(&summary).map_err(|e| DataError::file(&path, e.to_string()))?;
+    mannequin_io::write_atomic(&path, text.as_bytes()).map_err(|e| DataError::os(&path, e))?;
+    Ok(summary)
+}

@@ -1,0 +1,116 @@
+//! A skirt: a surface of revolution around the pelvis in the rest pose, hanging from the waist
+//! over the hips and legs, skinned to the pelvis and both hips so that it follows the legs on
+//! average (the MGN-style garment-as-separate-mesh of the thesis, with blended skinning).
+
+use glam::Vec3;
+
+use super::clothing::{L_HIP, PELVIS, R_HIP, smoothstep};
+use mannequin_mesh::UvLayout;
+
+pub const SEGMENTS: usize = 64;
+pub const RINGS: usize = 28;
+/// Angular bins for measuring the body's cross-section.
+const BINS: usize = 48;
+
+pub struct Skirt {
+    /// Rest-pose positions, ring-major from the waist down.
+    pub positions: Vec<[f32; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    pub uv: UvLayout,
+    /// Per vertex, `(joint, weight)` pairs summing to one.
+    pub weights: Vec<[(usize, f32); 3]>,
+}
+
+/// Builds a skirt from `waist` down to `hem` height around the vertical axis through `centre`,
+/// enclosing `body` (the rest vertices considered, e.g. pelvis and legs) with `ease` metres of
+/// room and a flare of `flare` metres per metre of length.
+pub fn build_skirt(body: &[Vec3], centre: Vec3, waist: f32, hem: f32, ease: f32, flare: f32) -> Skirt {
+    let length = waist - hem;
+    // Body radius per ring and angle bin, from points at or above the ring (down to the hem),
+    // so the skirt never narrows below the widest part it has passed.
+    let mut radius = vec![[0.0f32; BINS]; RINGS + 1];
+    for p in body {
+        if p.y > waist + 0.02 || p.y < hem - 0.05 {
+            continue;
+        }
+        let d = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z);
+        let bin = (((d.z.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0)) * BINS as f32) as usize % BINS;
+        let ring = (((waist - p.y) / length * RINGS as f32).max(0.0) as usize).min(RINGS);
+        radius[ring][bin] = radius[ring][bin].max(d.length());
+    }
+    for r in 1..=RINGS {
+        for b in 0..BINS {
+            radius[r][b] = radius[r][b].max(radius[r - 1][b]);
+        }
+    }
+    let mut positions = Vec::with_capacity((RINGS + 1) * SEGMENTS);
+    let mut weights = Vec::with_capacity(positions.capacity());
+    let mut coords = Vec::with_capacity((RINGS + 1) * (SEGMENTS + 1));
+    for r in 0..=RINGS {
+        let s = r as f32 / RINGS as f32;
+        let y = waist - s * length;
+        for k in 0..SEGMENTS {
+            let theta = std::f32::consts::TAU * k as f32 / SEGMENTS as f32;
+            // Smooth the measured profile over neighbouring bins.
+            let bin = theta / std::f32::consts::TAU * BINS as f32;
+            let rad = (-2..=2)
+                .map(|o| radius[r][((bin as isize + o).rem_euclid(BINS as isize)) as usize])
+                .fold(0.0f32, f32::max);
+            let rad = rad.max(0.08) + ease + flare * s * length;
+            let (sin, cos) = theta.sin_cos();
+            positions.push([centre.x + rad * cos, y, centre.z + rad * sin]);
+            // Pelvis at the waist, blending into the nearer hip towards the hem.
+            let side = smoothstep(-0.08, 0.08, rad * cos);
+            let legs = 0.5 * smoothstep(0.0, 1.0, s);
+            weights.push([(PELVIS, 1.0 - legs), (L_HIP, legs * side), (R_HIP, legs * (1.0 - side))]);
+        }
+        for k in 0..=SEGMENTS {
+            coords.push([k as f32 / SEGMENTS as f32, 1.0 - s]);
+        }
+    }
+    let mut faces = Vec::with_capacity(2 * RINGS * SEGMENTS);
+    let mut uv_faces = Vec::with_capacity(faces.capacity());
+    for r in 0..RINGS {
+        for k in 0..SEGMENTS {
+            let v = |rr: usize, kk: usize| (rr * SEGMENTS + kk % SEGMENTS) as u32;
+            let t = |rr: usize, kk: usize| (rr * (SEGMENTS + 1) + kk) as u32;
+            // Counter-clockwise seen from outside, so face normals point outward.
+            faces.push([v(r, k), v(r, k + 1), v(r + 1, k + 1)]);
+            faces.push([v(r, k), v(r + 1, k + 1), v(r + 1, k)]);
+            uv_faces.push([t(r, k), t(r, k + 1), t(r + 1, k + 1)]);
+            uv_faces.push([t(r, k), t(r + 1, k + 1), t(r + 1, k)]);
+        }
+    }
+    Skirt { positions, faces, uv: UvLayout { coords, faces: uv_faces }, weights }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn skirt_encloses_the_body_and_faces_outward() {
+        // A body cylinder of radius 0.15 around (0.1, ·, 0.0), from y = 0 to 1.
+        let body: Vec<Vec3> = (0..2000)
+            .map(|i| {
+                let a = i as f32 * 0.37;
+                Vec3::new(0.1 + 0.15 * a.cos(), (i % 100) as f32 / 100.0, 0.15 * a.sin())
+            })
+            .collect();
+        let s = build_skirt(&body, Vec3::new(0.1, 0.0, 0.0), 0.9, 0.4, 0.01, 0.2);
+        assert_eq!(s.positions.len(), (RINGS + 1) * SEGMENTS);
+        for p in &s.positions {
+            let r = ((p[0] - 0.1).powi(2) + p[2].powi(2)).sqrt();
+            assert!(r >= 0.16 - 1e-4, "{p:?} radius {r}");
+        }
+        let n = mannequin_mesh::normals::face_normals(&s.positions, &s.faces);
+        for (f, n) in s.faces.iter().zip(&n) {
+            let c = f.iter().fold(Vec3::ZERO, |a, &i| a + Vec3::from(s.positions[i as usize])) / 3.0;
+            let out = Vec3::new(c.x - 0.1, 0.0, c.z).normalize();
+            assert!(Vec3::from(*n).dot(out) > 0.5);
+        }
+        for w in &s.weights {
+            assert!((w.iter().map(|x| x.1).sum::<f32>() - 1.0).abs() < 1e-6);
+        }
+    }
+}
