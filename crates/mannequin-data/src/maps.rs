@@ -32,29 +32,22 @@ fn is_background(n: [f32; 3]) -> bool {
     n == [0.0; 3]
 }
 
-/// Averages each `factor × factor` block over its foreground pixels (those `keep` accepts);
-/// a block without any is zero.
-fn block_mean<const C: usize>(
-    values: &[[f32; C]],
-    width: usize,
-    factor: usize,
-    keep: impl Fn([f32; C]) -> bool,
-    out_w: usize,
-    out_h: usize,
-) -> Vec<[f32; C]> {
+/// Averages each `factor × factor` block of normals over its foreground pixels; a block
+/// without any is zero.
+fn block_mean_normals(n: &NormalMap, factor: usize, out_w: usize, out_h: usize) -> Vec<[f32; 3]> {
     (0..out_w * out_h)
         .map(|p| {
             let (x, y) = (p % out_w, p / out_w);
-            let mut acc = [0.0f32; C];
-            let mut n = 0;
+            let mut acc = [0.0f32; 3];
+            let mut count = 0;
             for k in 0..factor * factor {
-                let v = values[(y * factor + k / factor) * width + x * factor + k % factor];
-                if keep(v) {
-                    (0..C).for_each(|c| acc[c] += v[c]);
-                    n += 1;
+                let v = n.normals[(y * factor + k / factor) * n.width + x * factor + k % factor];
+                if !is_background(v) {
+                    (0..3).for_each(|c| acc[c] += v[c]);
+                    count += 1;
                 }
             }
-            if n > 0 { acc.map(|a| a / n as f32) } else { [0.0; C] }
+            if count > 0 { acc.map(|a| a / count as f32) } else { [0.0; 3] }
         })
         .collect()
 }
@@ -92,7 +85,7 @@ impl NormalMap {
     /// Foreground-averaged, renormalised normals per block.
     pub fn downscale(&self, factor: usize) -> Self {
         let (w, h) = (self.width / factor, self.height / factor);
-        let normals = block_mean(&self.normals, self.width, factor, |n| !is_background(n), w, h)
+        let normals = block_mean_normals(self, factor, w, h)
             .into_iter()
             .map(|n| glam::Vec3::from(n).normalize_or_zero().to_array())
             .collect();
@@ -131,12 +124,19 @@ impl DepthMap {
         mannequin_io::write_atomic(path, &bytes).map_err(|e| DataError::os(path, e))
     }
 
-    /// Foreground-averaged depth per block.
+    /// The nearest foreground depth of each block: a depth of a surface that is really there,
+    /// where an average across a depth edge would float between two surfaces.
     pub fn downscale(&self, factor: usize) -> Self {
         let (w, h) = (self.width / factor, self.height / factor);
-        let as1: Vec<[f32; 1]> = self.depth.iter().map(|&d| [d]).collect();
-        let depth =
-            block_mean(&as1, self.width, factor, |d| d[0] > 0.0, w, h).into_iter().map(|d| d[0]).collect();
+        let depth = (0..w * h)
+            .map(|p| {
+                let (x, y) = (p % w, p / w);
+                (0..factor * factor)
+                    .map(|k| self.depth[(y * factor + k / factor) * self.width + x * factor + k % factor])
+                    .filter(|&d| d > 0.0)
+                    .fold(0.0f32, |m, d| if m == 0.0 { d } else { m.min(d) })
+            })
+            .collect();
         Self { width: w, height: h, depth }
     }
 }

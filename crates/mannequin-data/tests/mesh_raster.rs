@@ -61,8 +61,8 @@ fn tilted_textured_quad_gives_the_expected_pixels() {
             let (s, t, z) = ray_plane(&cam, x, y, o, a, b);
             let i = y * cam.width + x;
             // Stay a hair away from the border, where coverage is a tie.
-            let inside = s > 1e-9 && s < 1.0 - 1e-9 && t > 1e-9 && t < 1.0 - 1e-9;
-            let outside = s < -1e-9 || s > 1.0 + 1e-9 || t < -1e-9 || t > 1.0 + 1e-9;
+            let inside = [s, t].iter().all(|v| (1e-9..1.0 - 1e-9).contains(v));
+            let outside = [s, t].iter().any(|v| !(-1e-9..=1.0 + 1e-9).contains(v));
             if outside {
                 assert_eq!(out.face_id[i], NO_FACE, "pixel {x},{y}");
                 assert_eq!(out.color.pixels[i], [0.0, 0.0, 1.0]);
@@ -111,12 +111,14 @@ fn fronto_parallel_quad_covers_exactly_the_projected_rectangle() {
     assert_eq!(out.mask.count(), 18 * 15);
 }
 
-fn uv_sphere(
-    centre: [f32; 3],
-    r: f32,
-    rings: usize,
-    segments: usize,
-) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 3]>) {
+/// A UV sphere: positions, faces, and the exact (radial) vertex normals.
+struct Sphere {
+    positions: Vec<[f32; 3]>,
+    faces: Vec<[u32; 3]>,
+    normals: Vec<[f32; 3]>,
+}
+
+fn uv_sphere(centre: [f32; 3], r: f32, rings: usize, segments: usize) -> Sphere {
     let mut pos = Vec::new();
     let mut nrm = Vec::new();
     for i in 0..=rings {
@@ -136,15 +138,20 @@ fn uv_sphere(
             faces.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
         }
     }
-    (pos, faces, nrm)
+    Sphere { positions: pos, faces, normals: nrm }
 }
 
 #[test]
 fn sphere_normal_map_matches_analytic_normals() {
     let cam = Camera::look_at([0.4, 0.3, -3.0], [0.1, -0.1, 0.2], [0.0, 1.0, 0.0], 0.6, 96, 80);
     let (c, r) = (DVec3::new(0.1, -0.1, 0.2), 0.5);
-    let (pos, faces, nrm) = uv_sphere(c.as_vec3().to_array(), r as f32, 96, 192);
-    let mesh = RasterMesh { positions: &pos, faces: &faces, normals: &nrm, shading: Shading::Flat([1.0; 3]) };
+    let sphere = uv_sphere(c.as_vec3().to_array(), r as f32, 96, 192);
+    let mesh = RasterMesh {
+        positions: &sphere.positions,
+        faces: &sphere.faces,
+        normals: &sphere.normals,
+        shading: Shading::Flat([1.0; 3]),
+    };
     let out = rasterize(&mesh, &cam, [0.0; 3]);
     let (rot, eye) = (cam.rotation(), cam.centre());
     let (mut checked, mut worst) = (0, 0.0f64);

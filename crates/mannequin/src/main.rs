@@ -1,7 +1,9 @@
 //! `mannequin <verb>`: the one binary. Each verb lives in its own module with its clap
 //! arguments and a `run` function; this file only dispatches and reports errors.
 
+mod eval;
 mod progress;
+mod synth;
 
 use clap::{Parser, Subcommand};
 
@@ -16,12 +18,20 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Compare predictions with a ground-truth dataset: PSNR, SSIM, LPIPS, normal and geometry errors.
+    Eval(eval::Args),
+    /// Generate a synthetic clothed subject with full ground truth, in the dataset layout.
+    Synth(synth::Args),
+}
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     progress::init_logging(cli.verbose);
-    let result: anyhow::Result<()> = match cli.command {};
+    let result: anyhow::Result<()> = match cli.command {
+        Command::Eval(args) => eval::run(args),
+        Command::Synth(args) => synth::run(args),
+    };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

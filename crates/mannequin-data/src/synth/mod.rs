@@ -146,10 +146,13 @@ pub fn generate(
     let scene = Scene::new(model, &subject)?;
     let mut rng = crate::rng::SplitMix64::new(options.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xCA97);
 
-    // The capture: one camera, the subject turning.
+    // The capture: one camera, the subject turning. The camera also frames the novel poses,
+    // which are seen from it too.
     let capture_poses = motion::turning_a_pose(options.capture_frames, 1.25, &mut rng)?;
     let capture = scene.pose(model, &capture_poses)?;
-    let camera = scene.framing_camera(&capture, scene::TRAIN_VIEW, options.size);
+    let (motion_names, novel_poses) = motion::novel_poses(options.motion_frames, &mut rng)?;
+    let novel = scene.pose(model, &novel_poses)?;
+    let camera = scene.framing_camera(&[&capture, &novel], scene::TRAIN_VIEW, options.size);
     let root = DatasetWriter::new(out);
     root.write_cameras(&Cameras::Static(camera.clone()))?;
     let (train, test) = (options.train_frames, options.capture_frames);
@@ -182,7 +185,7 @@ pub fn generate(
     let views = scene.pose(model, &view_poses)?;
     let view_cameras: Vec<Camera> = (0..scene::NOVEL_VIEWS)
         .flat_map(|v| {
-            let cam = scene.framing_camera(&capture, scene::NOVEL_VIEW_SETUPS[v].1, options.size);
+            let cam = scene.framing_camera(&[&views], scene::NOVEL_VIEW_SETUPS[v].1, options.size);
             vec![cam; picks.len()]
         })
         .collect();
@@ -193,8 +196,6 @@ pub fn generate(
     write_frames(&scene, &views, &view_cameras, &nv, options.supersample, on_frame)?;
 
     // Novel poses: out-of-distribution motions from the training camera.
-    let (motion_names, novel_poses) = motion::novel_poses(options.motion_frames, &mut rng)?;
-    let novel = scene.pose(model, &novel_poses)?;
     let np = DatasetWriter::new(out.join("test/novel_pose"));
     np.write_cameras(&Cameras::Static(camera.clone()))?;
     np.write_splits(&one_split("test", novel.len()))?;

@@ -21,7 +21,7 @@ use crate::rng::SplitMix64;
 
 /// Texture sizes: the body's UV atlas and the skirt's strip beside it.
 const BODY_TEXTURE: usize = 1024;
-const SKIRT_TEXTURE: usize = 512;
+const SKIRT_TEXTURE: usize = 1024;
 
 /// Where a camera looks from, relative to the subject's bounding box centre: azimuth about +Y
 /// (0 is in front, on +Z), elevation, distance as a multiple of 3.3 m, and roll.
@@ -257,10 +257,10 @@ impl Scene {
         Ok(PosedSequence { vertices, transl })
     }
 
-    /// A camera of `setup` that frames every frame of `seq` with a margin.
-    pub fn framing_camera(&self, seq: &PosedSequence, setup: ViewSetup, size: usize) -> Camera {
+    /// A camera of `setup` that frames every frame of `seqs` with a margin.
+    pub fn framing_camera(&self, seqs: &[&PosedSequence], setup: ViewSetup, size: usize) -> Camera {
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for p in seq.vertices.iter().flatten() {
+        for p in seqs.iter().flat_map(|s| s.vertices.iter().flatten()) {
             let p = DVec3::from(p.map(f64::from));
             lo = lo.min(p);
             hi = hi.max(p);

@@ -39,14 +39,15 @@ pub fn build_skirt(body: &[Vec3], centre: Vec3, waist: f32, hem: f32, ease: f32,
         radius[ring][bin] = radius[ring][bin].max(d.length());
     }
     for r in 1..=RINGS {
-        for b in 0..BINS {
-            radius[r][b] = radius[r][b].max(radius[r - 1][b]);
+        let (above, below) = radius.split_at_mut(r);
+        for (b, a) in below[0].iter_mut().zip(&above[r - 1]) {
+            *b = b.max(*a);
         }
     }
     let mut positions = Vec::with_capacity((RINGS + 1) * SEGMENTS);
     let mut weights = Vec::with_capacity(positions.capacity());
     let mut coords = Vec::with_capacity((RINGS + 1) * (SEGMENTS + 1));
-    for r in 0..=RINGS {
+    for (r, ring) in radius.iter().enumerate() {
         let s = r as f32 / RINGS as f32;
         let y = waist - s * length;
         for k in 0..SEGMENTS {
@@ -54,7 +55,7 @@ pub fn build_skirt(body: &[Vec3], centre: Vec3, waist: f32, hem: f32, ease: f32,
             // Smooth the measured profile over neighbouring bins.
             let bin = theta / std::f32::consts::TAU * BINS as f32;
             let rad = (-2..=2)
-                .map(|o| radius[r][((bin as isize + o).rem_euclid(BINS as isize)) as usize])
+                .map(|o| ring[((bin as isize + o).rem_euclid(BINS as isize)) as usize])
                 .fold(0.0f32, f32::max);
             let rad = rad.max(0.08) + ease + flare * s * length;
             let (sin, cos) = theta.sin_cos();

@@ -78,7 +78,7 @@ fn look(rng: &mut SplitMix64) -> GarmentLook {
 impl Subject {
     /// The subject of `seed`, with `num_betas` shape coefficients (the model's count, at most 10).
     pub fn random(seed: u64, num_betas: usize) -> Self {
-        let mut rng = SplitMix64::new(seed ^ 0x5EED_0F_5B1EC7);
+        let mut rng = SplitMix64::new(seed ^ 0x5EED_0F5B_1EC7);
         let betas = (0..num_betas).map(|k| (rng.normal() * if k < 2 { 0.8 } else { 0.4 }) as f32).collect();
         let outfit = OUTFITS[rng.below(OUTFITS.len())];
         let tone = rng.range(0.25, 0.85) as f32;

@@ -98,7 +98,7 @@ fn text_ink(p: Vec3, chest: Vec3, rows: u32, seed: u64) -> bool {
     }
     // Word gaps: some cells are blank.
     let code = mix(seed ^ ((row * 64 + col) as u64) << 8);
-    code % 6 != 0 && glyph_on(code, gx, gy)
+    !code.is_multiple_of(6) && glyph_on(code, gx, gy)
 }
 
 fn garment_colour(look: &GarmentLook, p: Vec3, chest: Vec3, salt: u64) -> [f32; 3] {
