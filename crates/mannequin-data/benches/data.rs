@@ -1,20 +1,29 @@
-//! `cargo bench -p mannequin-data --bench data`: metric throughput at 540×540 (frames/s) and
-//! ground-truth rendering speed, each against a baseline measured in the same run, so the
-//! printed ratios do not depend on the machine.
+//! `cargo bench -p mannequin-data --bench data`: metric throughput at 540×540 (frames/s),
+//! ground-truth rendering and synthetic-subject generation, each against a baseline measured in
+//! the same run, so the printed ratios do not depend on the machine.
 //!
 //! - SSIM: the separable, parallel implementation against the direct 11×11 window, one thread.
-//! - PSNR and LPIPS-free evaluation throughput: PSNR + SSIM per frame.
-//! - Rasterizer: a ~13k-vertex mesh at 540², all cores against one thread.
+//! - PSNR + SSIM per frame; LPIPS (AlexNet, random weights) and the geometry metrics
+//!   (100k samples per mesh) on all threads against one.
+//! - Rasterizer: a ~13k-vertex mesh at 540², all threads against one.
+//! - `mannequin synth` with default settings (176 frames at 540²), timed once, and a short
+//!   capture on all threads against one.
 
 use std::time::Instant;
 
+use mannequin_body::BodyModel;
 use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_data::metrics::geometry::geometry_metrics;
+use mannequin_data::metrics::lpips::{Lpips, weight_shapes};
 use mannequin_data::metrics::{
     psnr::psnr,
     ssim::{ssim, ssim_direct},
 };
 use mannequin_data::rng::SplitMix64;
+use mannequin_data::synth::{SynthOptions, generate};
 use mannequin_data::{Camera, Image};
+use mannequin_io::{NpyArray, NpzWriter};
+use mannequin_mesh::TriMesh;
 
 const SIZE: usize = 540;
 
@@ -30,14 +39,21 @@ fn noisy_pair(seed: u64) -> (Image, Image) {
     (Image { width: SIZE, height: SIZE, pixels: a }, Image { width: SIZE, height: SIZE, pixels: b })
 }
 
-/// Seconds per call of `f`, over `n` calls after one warm-up.
-fn time<T>(n: usize, mut f: impl FnMut() -> T) -> f64 {
-    std::hint::black_box(f());
+/// Seconds per call of `f`, over `n` calls after `warm_up` untimed ones.
+fn time_after<T>(warm_up: usize, n: usize, mut f: impl FnMut() -> T) -> f64 {
+    for _ in 0..warm_up {
+        std::hint::black_box(f());
+    }
     let t = Instant::now();
     for _ in 0..n {
         std::hint::black_box(f());
     }
     t.elapsed().as_secs_f64() / n as f64
+}
+
+/// Seconds per call of `f`, over `n` calls after one warm-up.
+fn time<T>(n: usize, f: impl FnMut() -> T) -> f64 {
+    time_after(1, n, f)
 }
 
 fn sphere(rings: usize, segments: usize) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
@@ -58,6 +74,23 @@ fn sphere(rings: usize, segments: usize) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
         })
         .collect();
     (pos, faces)
+}
+
+/// LPIPS with random weights (uniform in ±sqrt(6 / fan-in)), through a weights file.
+fn random_lpips() -> Lpips {
+    let mut r = SplitMix64::new(9);
+    let mut w = NpzWriter::new();
+    for (key, shape) in weight_shapes() {
+        let fan_in: usize = shape[1..].iter().product();
+        let bound = (6.0 / fan_in as f64).sqrt();
+        let n: usize = shape.iter().product();
+        w.add(&key, NpyArray::f32(shape, (0..n).map(|_| r.range(-bound, bound) as f32).collect()));
+    }
+    let path = std::env::temp_dir().join(format!("mq-bench-lpips-{}.npz", std::process::id()));
+    w.write(&path).expect("temporary weights file");
+    let model = Lpips::load(&path).expect("weights just written");
+    let _ = std::fs::remove_file(path);
+    model
 }
 
 fn main() {
@@ -97,4 +130,51 @@ fn main() {
         1.0 / rn,
         r1 / rn
     );
+
+    let lpips = random_lpips();
+    let l1 = single.install(|| time(1, || lpips.distance(&a, &b)));
+    let ln = time(3, || lpips.distance(&a, &b));
+    println!(
+        "LPIPS 1 thread: {:6.2} frames/s; {threads} threads: {:6.2} frames/s ({:.1}×)",
+        1.0 / l1,
+        1.0 / ln,
+        l1 / ln
+    );
+
+    let gt = TriMesh::new(pos.clone(), faces.clone());
+    let pred = TriMesh::new(pos.iter().map(|p| [p[0] * 1.01, p[1], p[2] + 0.003]).collect(), faces.clone());
+    let g1 = single.install(|| time(1, || geometry_metrics(&pred, &gt, 100_000, 0)));
+    let gn = time(3, || geometry_metrics(&pred, &gt, 100_000, 0));
+    println!(
+        "Chamfer+P2S+NC, 100k samples: 1 thread {:.2} s; {threads} threads {:.2} s ({:.1}×)",
+        g1,
+        gn,
+        g1 / gn
+    );
+
+    let model = BodyModel::default_body();
+    let dir = std::env::temp_dir().join(format!("mq-bench-synth-{}", std::process::id()));
+    let short = SynthOptions {
+        capture_frames: 12,
+        train_frames: 8,
+        view_poses: 2,
+        motion_frames: 2,
+        ..SynthOptions::default()
+    };
+    let frames = short.total_frames() as f64;
+    let s1 = single
+        .install(|| time_after(0, 1, || generate(&model, &dir, &short, &|| {}).expect("synthetic subject")));
+    let sn = time_after(0, 1, || generate(&model, &dir, &short, &|| {}).expect("synthetic subject"));
+    println!(
+        "synth, {} frames: 1 thread {:.1} frames/s; {threads} threads {:.1} frames/s ({:.1}×)",
+        frames,
+        frames / s1,
+        frames / sn,
+        s1 / sn
+    );
+    let full = SynthOptions::default();
+    let t = Instant::now();
+    generate(&model, &dir, &full, &|| {}).expect("synthetic subject");
+    println!("synth default ({} frames at {SIZE}²): {:.1} s", full.total_frames(), t.elapsed().as_secs_f64());
+    let _ = std::fs::remove_dir_all(dir);
 }

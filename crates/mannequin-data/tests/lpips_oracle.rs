@@ -2,7 +2,7 @@
 //! tools/oracles/data_lpips.py; the weights are regenerated here with SplitMix64).
 
 use mannequin_data::Image;
-use mannequin_data::metrics::lpips::Lpips;
+use mannequin_data::metrics::lpips::{Lpips, weight_shapes};
 use mannequin_data::rng::SplitMix64;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
@@ -54,6 +54,28 @@ fn image(npz: &Npz, key: &str) -> Image {
         height: h,
         pixels: v.chunks_exact(3).map(|c| [c[0] / 255.0, c[1] / 255.0, c[2] / 255.0]).collect(),
     }
+}
+
+#[test]
+fn expected_keys_are_the_reference_parameters() {
+    let npz = fixture();
+    let keys = match &npz.require("keys").unwrap().data {
+        mannequin_io::NpyData::Str(v) => v.clone(),
+        other => panic!("keys: {other:?}"),
+    };
+    let shapes = npz.require("shapes").unwrap().to_i64().unwrap();
+    let ranks = npz.require("ranks").unwrap().to_i64().unwrap();
+    let mut reference: Vec<(String, Vec<usize>)> = keys
+        .iter()
+        .enumerate()
+        .map(|(k, key)| {
+            (key.clone(), shapes[4 * k..4 * k + ranks[k] as usize].iter().map(|&d| d as usize).collect())
+        })
+        .collect();
+    let mut ours = weight_shapes();
+    reference.sort();
+    ours.sort();
+    assert_eq!(ours, reference);
 }
 
 #[test]

@@ -138,20 +138,34 @@ fn unit_normalise(x: &mut Features) {
     x.data.par_chunks_mut(hw).for_each(|ch| ch.iter_mut().zip(&norm).for_each(|(v, n)| *v *= n));
 }
 
+/// The weight-file keys and shapes this network reads, stage by stage: the convolution's
+/// weight and bias, then the linear layer's weight.
+pub fn weight_shapes() -> Vec<(String, Vec<usize>)> {
+    CONVS
+        .iter()
+        .enumerate()
+        .flat_map(|(i, c)| {
+            [
+                (format!("{}.weight", c.key), vec![c.out, c.inp, c.k, c.k]),
+                (format!("{}.bias", c.key), vec![c.out]),
+                (format!("lin{i}.model.1.weight"), vec![1, c.out, 1, 1]),
+            ]
+        })
+        .collect()
+}
+
 impl Lpips {
     pub fn from_npz(npz: &Npz) -> Result<Self, DataError> {
+        let mut arrays = Vec::new();
+        for (key, shape) in weight_shapes() {
+            let expected: Vec<Option<usize>> = shape.iter().map(|&d| Some(d)).collect();
+            let (_, v) = npz.f64_with_shape(&key, &expected)?;
+            arrays.push(v.into_iter().map(|x| x as f32).collect::<Vec<f32>>());
+        }
+        let mut arrays = arrays.into_iter();
         let mut stages = Vec::new();
-        for (i, spec) in CONVS.iter().enumerate() {
-            let get = |key: String, shape: &[usize]| -> Result<Vec<f32>, DataError> {
-                let expected: Vec<Option<usize>> = shape.iter().map(|&d| Some(d)).collect();
-                let (_, v) = npz.f64_with_shape(&key, &expected)?;
-                Ok(v.into_iter().map(|x| x as f32).collect())
-            };
-            stages.push(Stage {
-                weight: get(format!("{}.weight", spec.key), &[spec.out, spec.inp, spec.k, spec.k])?,
-                bias: get(format!("{}.bias", spec.key), &[spec.out])?,
-                lin: get(format!("lin{i}.model.1.weight"), &[1, spec.out, 1, 1])?,
-            });
+        while let (Some(weight), Some(bias), Some(lin)) = (arrays.next(), arrays.next(), arrays.next()) {
+            stages.push(Stage { weight, bias, lin });
         }
         Ok(Self { stages })
     }
