@@ -76,7 +76,7 @@ fn synthetic_subject_is_a_consistent_dataset() {
         let (normals, depth) = (frame.normals.unwrap(), frame.depth.unwrap());
         // The subject is in view, not cut off: no foreground on the image border.
         let fg = frame.mask.count();
-        assert!(fg > 64 * 64 / 20, "frame {f}: {fg} foreground pixels");
+        assert!(fg > 64 * 64 / 40, "frame {f}: {fg} foreground pixels");
         for x in 0..64 {
             for y in [0, 63] {
                 assert!(
