@@ -133,6 +133,9 @@ fn score_frame(
     let p = Image::read_png(&pred_path)?;
     let g = Image::read_png(&gt_path)?;
     let factor = downscale_factor((p.width, p.height), (g.width, g.height), &pred_path, &gt_path)?;
+    if p.width.min(p.height) < 11 {
+        return Err(DataError::file(pred_path, "is smaller than SSIM's 11×11 window"));
+    }
     let mask_path = layout::mask(gt, frame);
     let mask = read_mask_npy(&mask_path)?;
     if (mask.width, mask.height) != (g.width, g.height) {
