@@ -28,10 +28,6 @@ pub fn quantize(v: f32) -> u8 {
 }
 
 impl Image {
-    pub fn filled(width: usize, height: usize, colour: [f32; 3]) -> Self {
-        Self { width, height, pixels: vec![colour; width * height] }
-    }
-
     pub fn at(&self, x: usize, y: usize) -> [f32; 3] {
         self.pixels[y * self.width + x]
     }
