@@ -1,6 +1,22 @@
 //! Triangle meshes: the data type, normals, differential operators, and file formats.
 
+pub mod adjacency;
+pub mod area;
+pub mod file_error;
+pub mod gltf;
+pub mod gradient;
+pub mod laplacian;
+pub mod mass;
 pub mod normals;
+pub mod obj;
+pub mod ply;
 pub mod tri_mesh;
 
+pub use area::double_areas;
+pub use file_error::MeshFileError;
+pub use gltf::{SkeletalAnimation, Skeleton, SkinnedMesh, write_glb};
+pub use gradient::gradient_operator;
+pub use laplacian::cotan_laplacian;
+pub use mass::{MassKind, mass_matrix, vertex_areas};
+pub use obj::{Obj, ObjGroup, read_obj, write_obj};
 pub use tri_mesh::{MeshError, TriMesh, UvLayout};

@@ -42,8 +42,8 @@ mod tests {
         let vn = vertex_normals(&p, &f);
         // The origin corner's normal is the mean of the three axis faces: -(1,1,1)/sqrt(3).
         let s = -1.0 / 3f32.sqrt();
-        for c in 0..3 {
-            assert!((vn[0][c] - s).abs() < 1e-6);
+        for c in vn[0] {
+            assert!((c - s).abs() < 1e-6);
         }
     }
 }

@@ -48,6 +48,27 @@ impl TriMesh {
         self.faces.len()
     }
 
+    /// The mesh made of the listed faces and only the vertices they use, kept in their original
+    /// order, with the index each kept vertex had here: how one garment or body part is cut out of a
+    /// file that holds several.
+    pub fn submesh(&self, faces: &[usize]) -> (TriMesh, Vec<u32>) {
+        let (kept_vertices, vertex_map) = compact(faces.iter().map(|&f| self.faces[f]), self.positions.len());
+        let pick = |i: &u32| self.positions[*i as usize];
+        let mut mesh = TriMesh::new(
+            kept_vertices.iter().map(pick).collect(),
+            faces.iter().map(|&f| self.faces[f].map(|i| vertex_map[i as usize])).collect(),
+        );
+        mesh.colors = self.colors.as_ref().map(|c| kept_vertices.iter().map(|&i| c[i as usize]).collect());
+        mesh.uv = self.uv.as_ref().map(|uv| {
+            let (kept, map) = compact(faces.iter().map(|&f| uv.faces[f]), uv.coords.len());
+            UvLayout {
+                coords: kept.iter().map(|&i| uv.coords[i as usize]).collect(),
+                faces: faces.iter().map(|&f| uv.faces[f].map(|i| map[i as usize])).collect(),
+            }
+        });
+        (mesh, kept_vertices)
+    }
+
     /// Checks that every index is in range and every position is finite.
     pub fn validate(&self) -> Result<(), MeshError> {
         let n = self.positions.len();
@@ -77,4 +98,20 @@ impl TriMesh {
         }
         Ok(())
     }
+}
+
+/// The indices (ascending) that `tris` use out of `0..count`, and the map from old index to new.
+fn compact(tris: impl Iterator<Item = [u32; 3]>, count: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut used = vec![false; count];
+    for t in tris {
+        for i in t {
+            used[i as usize] = true;
+        }
+    }
+    let kept: Vec<u32> = (0..count as u32).filter(|&i| used[i as usize]).collect();
+    let mut map = vec![u32::MAX; count];
+    for (new, &old) in kept.iter().enumerate() {
+        map[old as usize] = new as u32;
+    }
+    (kept, map)
 }

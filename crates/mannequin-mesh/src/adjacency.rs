@@ -1,0 +1,73 @@
+//! Mesh connectivity: edges, vertex one-rings, and face neighbours across edges. The equilateral
+//! and Laplacian regularisers walk edges and one-rings; the normal-consistency loss compares the
+//! normals of faces that share an edge.
+
+/// Every undirected edge once, as `[low, high]`, sorted.
+pub fn edges(faces: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut e: Vec<[u32; 2]> =
+        faces.iter().flat_map(|&t| face_edges(t).map(|(a, b, _)| sorted(a, b))).collect();
+    e.sort_unstable();
+    e.dedup();
+    e
+}
+
+/// For each vertex, its neighbours along edges, sorted.
+pub fn one_rings(vertex_count: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut rings = vec![Vec::new(); vertex_count];
+    for [a, b] in edges(faces) {
+        rings[a as usize].push(b);
+        rings[b as usize].push(a);
+    }
+    for r in &mut rings {
+        r.sort_unstable();
+    }
+    rings
+}
+
+/// For each face and each k, the face across the edge from corner k to corner k+1 (libigl's
+/// `triangle_triangle_adjacency` layout). `None` on a boundary edge, and on a non-manifold edge
+/// (shared by more than two faces), where "the" neighbour is not defined.
+pub fn face_neighbors(faces: &[[u32; 3]]) -> Vec<[Option<u32>; 3]> {
+    let mut half: Vec<([u32; 2], u32, usize)> = faces
+        .iter()
+        .enumerate()
+        .flat_map(|(f, &t)| face_edges(t).map(move |(a, b, k)| (sorted(a, b), f as u32, k)))
+        .collect();
+    half.sort_unstable();
+    let mut neighbors = vec![[None; 3]; faces.len()];
+    for run in half.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, f, k), (_, g, l)] = *run {
+            neighbors[f as usize][k] = Some(g);
+            neighbors[g as usize][l] = Some(f);
+        }
+    }
+    neighbors
+}
+
+/// The three directed edges of a face with the corner each starts at.
+fn face_edges(t: [u32; 3]) -> [(u32, u32, usize); 3] {
+    [(t[0], t[1], 0), (t[1], t[2], 1), (t[2], t[0], 2)]
+}
+
+fn sorted(a: u32, b: u32) -> [u32; 2] {
+    if a < b { [a, b] } else { [b, a] }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_triangles_share_one_edge() {
+        let f = [[0, 1, 2], [2, 1, 3]];
+        assert_eq!(edges(&f), vec![[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]);
+        assert_eq!(one_rings(4, &f), vec![vec![1, 2], vec![0, 2, 3], vec![0, 1, 3], vec![1, 2]]);
+        assert_eq!(face_neighbors(&f), vec![[None, Some(1), None], [Some(0), None, None]]);
+    }
+
+    #[test]
+    fn non_manifold_edges_have_no_neighbour() {
+        let f = [[0, 1, 2], [1, 0, 3], [0, 1, 4]];
+        assert!(face_neighbors(&f).iter().all(|n| n[0].is_none()));
+    }
+}

@@ -1,0 +1,478 @@
+//! The `.glb` writer, checked from the outside: the file is parsed back with a small reader written
+//! here from the glTF 2.0 specification (GLB chunks, accessors, node TRS, LINEAR samplers,
+//! inverse bind matrices), the skin is applied from the file's own data, and the result is
+//! compared with analytic poses of a 3-joint arm and with linear blend skinning computed directly
+//! from the inputs. A second test runs the Khronos glTF-Validator when it is installed.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec3};
+use mannequin_mesh::{SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh, UvLayout, write_glb};
+use serde_json::Value;
+
+const RING: [[f32; 2]; 4] = [[0.1, 0.1], [-0.1, 0.1], [-0.1, -0.1], [0.1, -0.1]];
+const RING_X: [f32; 5] = [0.0, 0.5, 1.0, 1.5, 2.0];
+const FPS: f32 = 10.0;
+
+/// A square tube along +x from the shoulder (0,0,0) through the elbow (1,0,0) to the wrist
+/// (2,0,0), with a UV seam along one side. Rings at x = 0, 0.5 follow the shoulder, x = 1 is split
+/// half and half between shoulder and elbow, x = 1.5 follows the elbow and x = 2 the wrist.
+fn arm() -> SkinnedMesh {
+    let positions: Vec<[f32; 3]> =
+        RING_X.iter().flat_map(|&x| RING.iter().map(move |&[y, z]| [x, y, z])).collect();
+    let mut faces = Vec::new();
+    let mut uv_faces = Vec::new();
+    for r in 0..4u32 {
+        for k in 0..4u32 {
+            let v = |r: u32, k: u32| 4 * r + k % 4;
+            let t = |r: u32, k: u32| 5 * r + k; // k = 4 is the seam's second UV.
+            faces.extend([[v(r, k), v(r + 1, k), v(r + 1, k + 1)], [v(r, k), v(r + 1, k + 1), v(r, k + 1)]]);
+            uv_faces
+                .extend([[t(r, k), t(r + 1, k), t(r + 1, k + 1)], [t(r, k), t(r + 1, k + 1), t(r, k + 1)]]);
+        }
+    }
+    let coords = (0..5).flat_map(|r| (0..5).map(move |k| [k as f32 / 4.0, r as f32 / 4.0])).collect();
+    let mut mesh = TriMesh::new(positions, faces);
+    mesh.uv = Some(UvLayout { coords, faces: uv_faces });
+    mesh.colors = Some((0..20).map(|i| [i as f32 / 20.0, 0.5, 1.0 - i as f32 / 20.0]).collect());
+    let ring_weights = [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let weights = (0..20).flat_map(|v| ring_weights[v / 4]).collect();
+    let skeleton = Skeleton {
+        names: vec!["shoulder".into(), "elbow".into(), "wrist".into()],
+        parents: vec![None, Some(0), Some(1)],
+        bind_joints: vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
+    };
+    SkinnedMesh { mesh, skeleton, weights }
+}
+
+fn rz(degrees: f32) -> [f32; 4] {
+    Quat::from_rotation_z(degrees.to_radians()).to_array()
+}
+
+/// Frame 0: bind pose. 1: elbow +90° about z. 2: shoulder −90° and elbow +90° about z, moved by
+/// (0, 0, 0.3). 3: wrist +90° about x.
+fn motion() -> SkeletalAnimation {
+    let id = [0.0, 0.0, 0.0, 1.0];
+    let rx90 = Quat::from_rotation_x(90f32.to_radians()).to_array();
+    SkeletalAnimation {
+        fps: FPS,
+        local_rotations: vec![
+            vec![id; 3],
+            vec![id, rz(90.0), id],
+            vec![rz(-90.0), rz(90.0), id],
+            vec![id, id, rx90],
+        ],
+        root_translation: vec![[0.0; 3], [0.0; 3], [0.0, 0.0, 0.3], [0.0; 3]],
+    }
+}
+
+/// Where a bind-pose arm vertex goes in each frame, worked out by hand.
+fn analytic(frame: usize, [x, y, z]: [f32; 3]) -> [f32; 3] {
+    let ring = RING_X.iter().position(|&r| r == x).unwrap();
+    match (frame, ring) {
+        (0, _) | (1, 0 | 1) | (3, 0..=3) => [x, y, z],
+        // The elbow turns the forearm's +x into +y: (1 + a, y) ↦ (1 − y, a).
+        (1, 2) => [1.0 - y / 2.0, y / 2.0, z],
+        (1, 3) => [1.0 - y, 0.5, z],
+        (1, 4) => [1.0 - y, 1.0, z],
+        // The shoulder's −90° maps (x, y) ↦ (y, −x); the elbow's +90° undoes it for the forearm.
+        (2, 0 | 1) => [y, -x, z + 0.3],
+        (2, 2) => [y / 2.0, (y - 2.0) / 2.0, z + 0.3],
+        (2, 3) => [0.5, y - 1.0, z + 0.3],
+        (2, 4) => [1.0, y - 1.0, z + 0.3],
+        // The wrist's +90° about x maps (y, z) ↦ (−z, y).
+        (3, 4) => [x, -z, y],
+        _ => unreachable!(),
+    }
+}
+
+/// Linear blend skinning straight from the inputs: forward kinematics with bind offsets, then
+/// `Σ w_j G_j (v − J_j)`.
+fn direct_lbs(skinned: &SkinnedMesh, animation: &SkeletalAnimation, frame: usize) -> Vec<Vec3> {
+    let s = &skinned.skeleton;
+    let j_count = s.names.len();
+    let mut world: Vec<Mat4> = Vec::with_capacity(j_count);
+    for j in 0..j_count {
+        let q = Quat::from_array(animation.local_rotations[frame][j]);
+        let bind = Vec3::from(s.bind_joints[j]);
+        world.push(match s.parents[j] {
+            None => Mat4::from_rotation_translation(q, bind + Vec3::from(animation.root_translation[frame])),
+            Some(p) => world[p] * Mat4::from_rotation_translation(q, bind - Vec3::from(s.bind_joints[p])),
+        });
+    }
+    (0..skinned.mesh.vertex_count())
+        .map(|v| {
+            let p = Vec3::from(skinned.mesh.positions[v]);
+            (0..j_count)
+                .map(|j| {
+                    skinned.weights[v * j_count + j]
+                        * world[j].transform_point3(p - Vec3::from(s.bind_joints[j]))
+                })
+                .sum()
+        })
+        .collect()
+}
+
+/// A parsed `.glb`: its JSON document and binary chunk.
+struct Glb {
+    doc: Value,
+    bin: Vec<u8>,
+}
+
+impl Glb {
+    fn read(path: &Path) -> Glb {
+        let bytes = std::fs::read(path).unwrap();
+        let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as usize;
+        assert_eq!(&bytes[0..4], b"glTF");
+        assert_eq!(u32_at(4), 2, "GLB version");
+        assert_eq!(u32_at(8), bytes.len(), "GLB header length");
+        let json_len = u32_at(12);
+        assert_eq!(&bytes[16..20], b"JSON");
+        let bin_at = 20 + json_len;
+        let bin_len = u32_at(bin_at);
+        assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+        assert!(json_len % 4 == 0 && bin_len % 4 == 0, "chunks are 4-byte aligned");
+        assert_eq!(bin_at + 8 + bin_len, bytes.len(), "nothing after the BIN chunk");
+        let doc: Value = serde_json::from_slice(&bytes[20..bin_at]).unwrap();
+        let bin = bytes[bin_at + 8..bin_at + 8 + bin_len].to_vec();
+        assert!(doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize <= bin.len());
+        Glb { doc, bin }
+    }
+
+    /// An accessor's elements as f32 rows (integers converted), honouring offsets.
+    fn accessor(&self, index: &Value) -> Vec<Vec<f32>> {
+        let a = &self.doc["accessors"][index.as_u64().unwrap() as usize];
+        let view = &self.doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+        assert!(view.get("byteStride").is_none());
+        let n = match a["type"].as_str().unwrap() {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC3" => 3,
+            "VEC4" => 4,
+            "MAT4" => 16,
+            t => panic!("type {t}"),
+        };
+        let (size, read): (usize, fn(&[u8]) -> f32) = match a["componentType"].as_u64().unwrap() {
+            5126 => (4, |b| f32::from_le_bytes(b.try_into().unwrap())),
+            5125 => (4, |b| u32::from_le_bytes(b.try_into().unwrap()) as f32),
+            5123 => (2, |b| u16::from_le_bytes(b.try_into().unwrap()) as f32),
+            5121 => (1, |b| b[0] as f32),
+            c => panic!("componentType {c}"),
+        };
+        let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + a["byteOffset"].as_u64().unwrap_or(0) as usize;
+        assert_eq!(start % size, 0, "accessor data is aligned to its component size");
+        let count = a["count"].as_u64().unwrap() as usize;
+        assert!(count * n * size <= view["byteLength"].as_u64().unwrap() as usize);
+        (0..count)
+            .map(|i| (0..n).map(|c| read(&self.bin[start + (i * n + c) * size..][..size])).collect())
+            .collect()
+    }
+
+    /// The posed vertices at time `t`: nodes' TRS with animated channels sampled (LINEAR: lerp for
+    /// translation, slerp for rotation), world matrices down the node tree, then
+    /// `Σ w_k (world(joint_k) · IBM_k) v` over JOINTS_0/WEIGHTS_0.
+    fn skin_at(&self, t: f32) -> (Vec<[f32; 3]>, Vec<Vec3>) {
+        let nodes = self.doc["nodes"].as_array().unwrap();
+        let vec = |v: &Value, default: &[f32]| -> Vec<f32> {
+            v.as_array().map_or(default.to_vec(), |a| a.iter().map(|x| x.as_f64().unwrap() as f32).collect())
+        };
+        let mut translation: Vec<Vec3> =
+            nodes.iter().map(|n| Vec3::from_slice(&vec(&n["translation"], &[0.0; 3]))).collect();
+        let mut rotation: Vec<Quat> =
+            nodes.iter().map(|n| Quat::from_slice(&vec(&n["rotation"], &[0.0, 0.0, 0.0, 1.0]))).collect();
+        for n in nodes {
+            assert!(n.get("scale").is_none() && n.get("matrix").is_none());
+        }
+        let animation = &self.doc["animations"][0];
+        for channel in animation["channels"].as_array().unwrap() {
+            let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
+            assert_eq!(sampler["interpolation"], "LINEAR");
+            let times: Vec<f32> = self.accessor(&sampler["input"]).into_iter().map(|r| r[0]).collect();
+            let values = self.accessor(&sampler["output"]);
+            let k = times.iter().rposition(|&x| x <= t).unwrap().min(times.len() - 2);
+            let s = ((t - times[k]) / (times[k + 1] - times[k])).clamp(0.0, 1.0);
+            let node = channel["target"]["node"].as_u64().unwrap() as usize;
+            match channel["target"]["path"].as_str().unwrap() {
+                "rotation" => {
+                    rotation[node] = Quat::from_slice(&values[k]).slerp(Quat::from_slice(&values[k + 1]), s);
+                }
+                "translation" => {
+                    translation[node] =
+                        Vec3::from_slice(&values[k]).lerp(Vec3::from_slice(&values[k + 1]), s);
+                }
+                p => panic!("path {p}"),
+            }
+        }
+        let mut parent = vec![None; nodes.len()];
+        for (i, n) in nodes.iter().enumerate() {
+            for c in n["children"].as_array().into_iter().flatten() {
+                parent[c.as_u64().unwrap() as usize] = Some(i);
+            }
+        }
+        let world = |mut i: usize| {
+            let mut m = Mat4::from_rotation_translation(rotation[i], translation[i]);
+            while let Some(p) = parent[i] {
+                m = Mat4::from_rotation_translation(rotation[p], translation[p]) * m;
+                i = p;
+            }
+            m
+        };
+        let skin = &self.doc["skins"][0];
+        let ibm = self.accessor(&skin["inverseBindMatrices"]);
+        let joint_matrix: Vec<Mat4> = skin["joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .map(|(j, node)| world(node.as_u64().unwrap() as usize) * Mat4::from_cols_slice(&ibm[j]))
+            .collect();
+        let attributes = &self.doc["meshes"][0]["primitives"][0]["attributes"];
+        let bind: Vec<[f32; 3]> =
+            self.accessor(&attributes["POSITION"]).iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let joints = self.accessor(&attributes["JOINTS_0"]);
+        let weights = self.accessor(&attributes["WEIGHTS_0"]);
+        let posed = (0..bind.len())
+            .map(|v| {
+                (0..4)
+                    .map(|k| {
+                        weights[v][k]
+                            * joint_matrix[joints[v][k] as usize].transform_point3(Vec3::from(bind[v]))
+                    })
+                    .sum()
+            })
+            .collect();
+        (bind, posed)
+    }
+}
+
+fn temp_file(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("mq-gltf-{}-{name}", std::process::id()))
+}
+
+fn assert_close(got: Vec3, want: Vec3, what: &str) {
+    assert!((got - want).abs().max_element() < 1e-5, "{what}: got {got}, want {want}");
+}
+
+#[test]
+fn skinning_from_the_file_matches_analytic_poses_and_direct_lbs() {
+    let (arm, motion) = (arm(), motion());
+    let path = temp_file("arm.glb");
+    write_glb(&path, &arm, Some(&motion)).unwrap();
+    let glb = Glb::read(&path);
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(glb.doc["asset"]["version"], "2.0");
+    assert_eq!(glb.doc["asset"]["generator"], "Mannequin");
+    for view in glb.doc["bufferViews"].as_array().unwrap() {
+        assert_eq!(view["byteOffset"].as_u64().unwrap() % 4, 0, "buffer views are 4-byte aligned");
+    }
+
+    // Time keys are i / fps.
+    let sampler = &glb.doc["animations"][0]["samplers"][0];
+    let times = glb.accessor(&sampler["input"]);
+    assert_eq!(times, (0..4).map(|i| vec![i as f32 / FPS]).collect::<Vec<_>>());
+    let input = &glb.doc["accessors"][sampler["input"].as_u64().unwrap() as usize];
+    assert_eq!(
+        (input["min"][0].as_f64(), input["max"][0].as_f64()),
+        (Some(0.0), Some((3.0f32 / FPS) as f64))
+    );
+
+    // Each of the 20 vertices appears once per distinct UV: the 5 seam vertices twice.
+    let attributes = &glb.doc["meshes"][0]["primitives"][0]["attributes"];
+    let uvs = glb.accessor(&attributes["TEXCOORD_0"]);
+    let (bind, _) = glb.skin_at(0.0);
+    assert_eq!(bind.len(), 25);
+    let source: Vec<usize> =
+        bind.iter().map(|p| arm.mesh.positions.iter().position(|q| q == p).unwrap()).collect();
+    let layout = arm.mesh.uv.as_ref().unwrap();
+    let mut corners: Vec<(usize, [u32; 2])> = Vec::new();
+    for (f, tri) in arm.mesh.faces.iter().enumerate() {
+        for (&vertex, &t) in tri.iter().zip(&layout.faces[f]) {
+            let [u, v] = layout.coords[t as usize];
+            corners.push((vertex as usize, [u.to_bits(), (1.0 - v).to_bits()]));
+        }
+    }
+    corners.sort_unstable();
+    corners.dedup();
+    let mut written: Vec<(usize, [u32; 2])> =
+        (0..25).map(|i| (source[i], [uvs[i][0].to_bits(), uvs[i][1].to_bits()])).collect();
+    written.sort_unstable();
+    assert_eq!(written, corners, "TEXCOORD_0 holds each (vertex, flipped UV) corner once");
+    let colors = glb.accessor(&attributes["COLOR_0"]);
+    for (i, &s) in source.iter().enumerate() {
+        assert_eq!(colors[i], arm.mesh.colors.as_ref().unwrap()[s].to_vec());
+    }
+    let position = &glb.doc["accessors"][attributes["POSITION"].as_u64().unwrap() as usize];
+    assert_eq!(position["min"], serde_json::json!([0.0, -0.1f32, -0.1f32]));
+    assert_eq!(position["max"], serde_json::json!([2.0, 0.1f32, 0.1f32]));
+
+    for frame in 0..4 {
+        let (_, posed) = glb.skin_at(frame as f32 / FPS);
+        let direct = direct_lbs(&arm, &motion, frame);
+        for (i, &s) in source.iter().enumerate() {
+            let what = format!("frame {frame}, vertex {s}");
+            assert_close(posed[i], Vec3::from(analytic(frame, arm.mesh.positions[s])), &what);
+            assert_close(direct[s], posed[i], &what);
+        }
+    }
+
+    // Halfway between frames 0 and 1 the LINEAR sampler slerps the elbow to 45°.
+    let (_, posed) = glb.skin_at(0.5 / FPS);
+    let (c, s) = (45f32.to_radians().cos(), 45f32.to_radians().sin());
+    for (i, &v) in source.iter().enumerate() {
+        let [x, y, z] = arm.mesh.positions[v];
+        if x == 1.5 {
+            assert_close(posed[i], Vec3::new(1.0 + 0.5 * c - y * s, 0.5 * s + y * c, z), "halfway");
+        }
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors_naming_the_field() {
+    let path = temp_file("bad.glb");
+    let mut arm = arm();
+    arm.weights.pop();
+    let e = write_glb(&path, &arm, None).unwrap_err().to_string();
+    assert!(e.contains("weights") && e.contains("60 values"), "{e}");
+
+    let arm_ok = self::arm();
+    let mut m = motion();
+    m.local_rotations[2][1] = [0.0, 0.0, 0.0, 2.0];
+    let e = write_glb(&path, &arm_ok, Some(&m)).unwrap_err().to_string();
+    assert!(e.contains("animation frame 2, joint 1") && e.contains("unit quaternion"), "{e}");
+
+    let mut m = motion();
+    m.root_translation.pop();
+    assert!(write_glb(&path, &arm_ok, Some(&m)).unwrap_err().to_string().contains("root_translation"));
+
+    let mut arm = self::arm();
+    arm.skeleton.parents[1] = Some(2);
+    let e = write_glb(&path, &arm, None).unwrap_err().to_string();
+    assert!(e.contains("skeleton.parents[1]"), "{e}");
+
+    let mut arm = self::arm();
+    arm.weights[..12].fill(0.0);
+    let e = write_glb(&path, &arm, None).unwrap_err().to_string();
+    assert!(e.contains("weights[vertex 0]") && e.contains("positive"), "{e}");
+    assert!(!path.exists(), "nothing is written on error");
+}
+
+/// A deterministic generator for test weights (splitmix64), so the test needs no seed crate.
+fn splitmix(state: &mut u64) -> f32 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+}
+
+/// A 300-joint chain (so JOINTS_0 needs u16) over a 12×12 grid whose vertices each have about a
+/// dozen non-zero weights (so the top-4 reduction matters), with a 2-frame motion.
+fn many_joints() -> (SkinnedMesh, SkeletalAnimation) {
+    let (n, joints) = (12usize, 300usize);
+    let positions: Vec<[f32; 3]> =
+        (0..n * n).map(|i| [(i % n) as f32 * 0.1, (i / n) as f32 * 0.1, 0.0]).collect();
+    let faces = (0..n - 1)
+        .flat_map(|r| (0..n - 1).map(move |c| (r * n + c) as u32))
+        .flat_map(|a| [[a, a + 1, a + n as u32 + 1], [a, a + n as u32 + 1, a + n as u32]])
+        .collect();
+    let mut seed = 7;
+    let weights = (0..n * n * joints).map(|_| (splitmix(&mut seed) - 0.96).max(0.0)).collect();
+    let skeleton = Skeleton {
+        names: (0..joints).map(|j| format!("j{j}")).collect(),
+        parents: (0..joints).map(|j| j.checked_sub(1)).collect(),
+        bind_joints: (0..joints).map(|j| [j as f32 * 0.01, 0.0, 0.0]).collect(),
+    };
+    let animation = SkeletalAnimation {
+        fps: 30.0,
+        local_rotations: vec![vec![[0.0, 0.0, 0.0, 1.0]; joints], vec![rz(1.0); joints]],
+        // The second frame's rotations are negated quaternions: the same rotation, which the
+        // writer must keep in the first frame's hemisphere.
+        root_translation: vec![[0.0; 3], [0.1, 0.0, 0.0]],
+    };
+    let mut animation = animation;
+    for q in &mut animation.local_rotations[1] {
+        *q = q.map(|c| -c);
+    }
+    (SkinnedMesh { mesh: TriMesh::new(positions, faces), skeleton, weights }, animation)
+}
+
+#[test]
+fn many_joints_use_u16_indices_and_stay_normalised() {
+    let (skinned, animation) = many_joints();
+    let path = temp_file("many.glb");
+    write_glb(&path, &skinned, Some(&animation)).unwrap();
+    let glb = Glb::read(&path);
+    std::fs::remove_file(&path).unwrap();
+    let attributes = &glb.doc["meshes"][0]["primitives"][0]["attributes"];
+    let joints_accessor = &glb.doc["accessors"][attributes["JOINTS_0"].as_u64().unwrap() as usize];
+    assert_eq!(joints_accessor["componentType"], 5123);
+    let joints = glb.accessor(&attributes["JOINTS_0"]);
+    let weights = glb.accessor(&attributes["WEIGHTS_0"]);
+    let (bind, _) = glb.skin_at(0.0);
+    let j = skinned.skeleton.names.len();
+    for v in 0..bind.len() {
+        let src = skinned.mesh.positions.iter().position(|p| *p == bind[v]).unwrap();
+        let row = &skinned.weights[src * j..(src + 1) * j];
+        let mut sorted: Vec<f32> = row.to_vec();
+        sorted.sort_by(|a, b| b.total_cmp(a));
+        let kept: f32 = sorted[..4].iter().sum();
+        assert!((weights[v].iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        for k in 0..4 {
+            if weights[v][k] > 0.0 {
+                assert!((weights[v][k] - row[joints[v][k] as usize] / kept).abs() < 1e-6);
+            }
+            assert!(
+                weights[v][k] == 0.0 || row[joints[v][k] as usize] >= sorted[3],
+                "vertex {v} keeps a top-4 joint"
+            );
+        }
+    }
+    for sampler in glb.doc["animations"][0]["samplers"].as_array().unwrap() {
+        let out = glb.accessor(&sampler["output"]);
+        if out[0].len() == 4 {
+            let dot: f32 = (0..4).map(|c| out[0][c] * out[1][c]).sum();
+            assert!(dot > 0.0, "consecutive rotation keys share a hemisphere");
+        }
+    }
+}
+
+/// Runs the Khronos validator (tools/gltf_validate.mjs) on the arm and the 300-joint export.
+/// Without the validator installed this test says so and passes, unless
+/// MANNEQUIN_REQUIRE_GLTF_VALIDATOR=1 (as in CI).
+#[test]
+fn khronos_validator_reports_no_errors() {
+    let dir = std::env::var_os("GLTF_VALIDATOR_DIR").map(PathBuf::from).unwrap_or_else(|| {
+        PathBuf::from(std::env::var_os("HOME").unwrap_or_default())
+            .join(".cache/gltf-validator/node_modules/gltf-validator")
+    });
+    let node_ok =
+        std::process::Command::new("node").arg("--version").output().is_ok_and(|o| o.status.success());
+    if !(dir.join("package.json").exists() && node_ok) {
+        let message = format!(
+            "glTF validator not found at {} (or node missing); install with: \
+             npm install --prefix \"$HOME/.cache/gltf-validator\" gltf-validator",
+            dir.display()
+        );
+        assert!(std::env::var("MANNEQUIN_REQUIRE_GLTF_VALIDATOR").as_deref() != Ok("1"), "{message}");
+        eprintln!("SKIPPED: {message}");
+        return;
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf_validate.mjs");
+    let (many, many_motion) = many_joints();
+    for (name, skinned, animation) in [("arm.glb", arm(), motion()), ("many.glb", many, many_motion)] {
+        let path = temp_file(&format!("validate-{name}"));
+        write_glb(&path, &skinned, Some(&animation)).unwrap();
+        let out = std::process::Command::new("node")
+            .arg(&script)
+            .arg(&path)
+            .env("GLTF_VALIDATOR_DIR", &dir)
+            .output()
+            .unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let report = String::from_utf8_lossy(&out.stdout);
+        eprintln!("{report}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(out.status.success(), "{name}: validator reported errors:\n{report}");
+        assert!(report.contains(" 0 errors, 0 warnings"), "{name}: {report}");
+    }
+}
