@@ -44,7 +44,11 @@ for (const clip of gltf.animations) {
 /// The world-space bounding box of the skinned vertices at time t of the first clip.
 function posedBox(mesh, t) {
   const mixer = new THREE.AnimationMixer(gltf.scene);
-  mixer.clipAction(gltf.animations[0]).play();
+  // Play once and hold the last pose: a looping clip at t = duration wraps back to its first key.
+  const action = mixer.clipAction(gltf.animations[0]);
+  action.setLoop(THREE.LoopOnce, 1);
+  action.clampWhenFinished = true;
+  action.play();
   mixer.setTime(t);
   gltf.scene.updateMatrixWorld(true);
   mesh.skeleton.update();
@@ -60,7 +64,8 @@ function posedBox(mesh, t) {
 }
 if (skinned.length && gltf.animations.length) {
   const d = gltf.animations[0].duration;
-  console.log(`  posed box at t=0: ${posedBox(skinned[0], 0)}`);
-  console.log(`  posed box at t=${d.toFixed(4)}: ${posedBox(skinned[0], d)}`);
+  for (const t of [0, d / 3, d]) {
+    console.log(`  posed box at t=${t.toFixed(4)}: ${posedBox(skinned[0], t)}`);
+  }
 }
 process.exit(skinned.length && gltf.animations.length ? 0 : 1);
