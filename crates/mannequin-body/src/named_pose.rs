@@ -1,0 +1,80 @@
+//! A few named SMPL poses (24 joints × axis-angle) for previews, tests and synthetic captures.
+//! Axes are SMPL's: Y up, the body faces +Z, the subject's left is +X. So a positive turn about
+//! +Z lifts the left arm, and a negative turn about +X swings a thigh forward.
+
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
+
+use crate::error::BodyError;
+
+/// SMPL joint indices used below.
+mod joint {
+    pub const L_HIP: usize = 1;
+    pub const R_HIP: usize = 2;
+    pub const L_KNEE: usize = 4;
+    pub const R_KNEE: usize = 5;
+    pub const L_ANKLE: usize = 7;
+    pub const R_ANKLE: usize = 8;
+    pub const L_COLLAR: usize = 13;
+    pub const R_COLLAR: usize = 14;
+    pub const L_SHOULDER: usize = 16;
+    pub const R_SHOULDER: usize = 17;
+    pub const L_ELBOW: usize = 18;
+    pub const R_ELBOW: usize = 19;
+}
+
+/// Names accepted by [`named_pose`].
+pub const POSE_NAMES: [&str; 6] = ["t-pose", "a-pose", "arms-raised", "squat", "walk", "arms-crossed"];
+
+fn set(pose: &mut [f32; 72], j: usize, r: [f32; 3]) {
+    pose[3 * j..3 * j + 3].copy_from_slice(&r);
+}
+
+/// The 72-value SMPL pose called `name` (see [`POSE_NAMES`]).
+pub fn named_pose(name: &str) -> Result<[f32; 72], BodyError> {
+    use joint::*;
+    let mut p = [0.0f32; 72];
+    match name {
+        "t-pose" => {}
+        "a-pose" => {
+            set(&mut p, L_SHOULDER, [0.0, 0.0, -FRAC_PI_4]);
+            set(&mut p, R_SHOULDER, [0.0, 0.0, FRAC_PI_4]);
+        }
+        "arms-raised" => {
+            set(&mut p, L_COLLAR, [0.0, 0.0, 0.3]);
+            set(&mut p, R_COLLAR, [0.0, 0.0, -0.3]);
+            set(&mut p, L_SHOULDER, [0.0, 0.0, FRAC_PI_2 - 0.3]);
+            set(&mut p, R_SHOULDER, [0.0, 0.0, -(FRAC_PI_2 - 0.3)]);
+        }
+        "squat" => {
+            set(&mut p, L_HIP, [-1.7, 0.0, -0.15]);
+            set(&mut p, R_HIP, [-1.7, 0.0, 0.15]);
+            set(&mut p, L_KNEE, [2.0, 0.0, 0.0]);
+            set(&mut p, R_KNEE, [2.0, 0.0, 0.0]);
+            set(&mut p, L_ANKLE, [-0.3, 0.0, 0.0]);
+            set(&mut p, R_ANKLE, [-0.3, 0.0, 0.0]);
+            // Arms reach forward for balance: a negative turn about +Y swings the left arm to +Z.
+            set(&mut p, L_SHOULDER, [0.0, -1.2, -0.3]);
+            set(&mut p, R_SHOULDER, [0.0, 1.2, 0.3]);
+        }
+        "walk" => {
+            // Left leg forward, right leg back; arms swing opposite.
+            set(&mut p, L_HIP, [-0.5, 0.0, 0.0]);
+            set(&mut p, L_KNEE, [0.25, 0.0, 0.0]);
+            set(&mut p, R_HIP, [0.35, 0.0, 0.0]);
+            set(&mut p, R_KNEE, [0.5, 0.0, 0.0]);
+            set(&mut p, L_SHOULDER, [0.0, 0.0, -1.25]);
+            set(&mut p, R_SHOULDER, [0.0, 0.0, 1.25]);
+            set(&mut p, L_ELBOW, [0.0, 0.0, 0.0]);
+        }
+        "arms-crossed" => {
+            set(&mut p, L_SHOULDER, [0.0, -1.1, -0.5]);
+            set(&mut p, R_SHOULDER, [0.0, 1.1, 0.5]);
+            set(&mut p, L_ELBOW, [0.0, -1.6, 0.0]);
+            set(&mut p, R_ELBOW, [0.0, 1.6, 0.0]);
+        }
+        other => {
+            return Err(BodyError::input("pose name", format!("unknown '{other}'; expected one of {}", POSE_NAMES.join(", "))));
+        }
+    }
+    Ok(p)
+}

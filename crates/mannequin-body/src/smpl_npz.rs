@@ -1,0 +1,162 @@
+//! Loads SMPL, SMPL-H and SMPL-X model files in the `.npz` layout (`v_template, shapedirs,
+//! posedirs, J_regressor, weights, kintree_table, f`), float32 or float64 alike.
+//!
+//! The original `.pkl` files hold numpy and scipy-sparse arrays; convert them once with
+//! (needs numpy, scipy; chumpy too for the original SMPL release):
+//!
+//! ```text
+//! python -c "import sys,pickle,numpy as n; d=pickle.load(open(sys.argv[1],'rb'),encoding='latin1'); n.savez(sys.argv[2],**{k:(v.toarray() if hasattr(v,'toarray') else n.asarray(v)) for k,v in d.items() if k!='bs_type' and k!='bs_style'})" model.pkl model.npz
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use mannequin_io::{NpyData, Npz};
+use mannequin_mesh::UvLayout;
+
+use crate::error::BodyError;
+use crate::model::{BodyModel, BodyModelParts};
+
+/// Shape-space size of SMPL-X: components past this index are expressions.
+const SMPLX_SHAPE_SPACE: usize = 300;
+
+/// Keys the forward pass reads; every other array is kept in `extras`.
+const CORE_KEYS: &[&str] = &[
+    "v_template",
+    "f",
+    "shapedirs",
+    "posedirs",
+    "J_regressor",
+    "weights",
+    "kintree_table",
+    "vt",
+    "ft",
+    "joint_names",
+    "shape_names",
+    "gender",
+];
+
+/// Reorders an `(V, 3, K)` array into component-major `[K][3V]`.
+fn component_major(values: &[f64], v: usize, k: usize) -> Vec<f32> {
+    let mut out = vec![0.0f32; k * 3 * v];
+    for (row, chunk) in values.chunks_exact(k).enumerate() {
+        for (c, &x) in chunk.iter().enumerate() {
+            out[c * 3 * v + row] = x as f32;
+        }
+    }
+    out
+}
+
+fn strings(npz: &Npz, key: &str) -> Vec<String> {
+    match npz.get(key).map(|a| &a.data) {
+        Some(NpyData::Str(s)) => s.clone(),
+        _ => Vec::new(),
+    }
+}
+
+fn index_triples(npz: &Npz, key: &str, bound: usize) -> Result<Vec<[u32; 3]>, BodyError> {
+    let a = npz.require(key)?;
+    if a.shape.len() != 2 || a.shape[1] != 3 {
+        return Err(npz.field_error(key, format!("expected shape (*, 3), found {:?}", a.shape)).into());
+    }
+    let ints = a.to_i64().ok_or_else(|| npz.field_error(key, format!("expected integers, found {}", a.dtype_name())))?;
+    if let Some(&bad) = ints.iter().find(|&&i| i < 0 || i as usize >= bound) {
+        return Err(npz.field_error(key, format!("index {bad} is outside 0..{bound}")).into());
+    }
+    Ok(ints.chunks_exact(3).map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect())
+}
+
+/// Parents from `kintree_table` row 0; the root's parent is -1 or 2³²−1 in the wild.
+fn parents(npz: &Npz) -> Result<Vec<Option<usize>>, BodyError> {
+    let key = "kintree_table";
+    let a = npz.require(key)?;
+    if a.shape.len() != 2 || a.shape[0] != 2 {
+        return Err(npz.field_error(key, format!("expected shape (2, J), found {:?}", a.shape)).into());
+    }
+    let j = a.shape[1];
+    let ints = a.to_i64().ok_or_else(|| npz.field_error(key, "expected integers"))?;
+    let ids = &ints[j..];
+    if ids.iter().enumerate().any(|(k, &id)| id != k as i64) {
+        return Err(npz.field_error(key, "row 1 must list the joints in order 0..J").into());
+    }
+    Ok(ints[..j]
+        .iter()
+        .map(|&p| if p < 0 || p >= j as i64 { None } else { Some(p as usize) })
+        .collect())
+}
+
+/// Reads a SMPL-family model from the bytes of an `.npz` file; `path` names it in errors.
+pub fn parse_model(npz: &Npz, num_betas: Option<usize>) -> Result<BodyModel, BodyError> {
+    let path = npz.path.clone();
+    let (_, vt) = npz.f64_with_shape("v_template", &[None, Some(3)])?;
+    let v = vt.len() / 3;
+    let v_template: Vec<[f32; 3]> = vt.chunks_exact(3).map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]).collect();
+    let faces = index_triples(npz, "f", v)?;
+    let parents = parents(npz)?;
+    let j = parents.len();
+
+    let (sd_shape, sd) = npz.f64_with_shape("shapedirs", &[Some(v), Some(3), None])?;
+    let stored = sd_shape[2];
+    let family_is_x = j == 55;
+    let (file_betas, num_expression) =
+        if family_is_x && stored > SMPLX_SHAPE_SPACE { (SMPLX_SHAPE_SPACE, stored - SMPLX_SHAPE_SPACE) } else { (stored, 0) };
+    let shapedirs = component_major(&sd, v, stored);
+    let posedirs = match npz.get("posedirs") {
+        Some(a) if a.shape.len() == 3 && a.shape[2] == 0 => Vec::new(),
+        _ => {
+            let (_, pd) = npz.f64_with_shape("posedirs", &[Some(v), Some(3), Some(9 * (j - 1))])?;
+            component_major(&pd, v, 9 * (j - 1))
+        }
+    };
+    let (_, jr) = npz.f64_with_shape("J_regressor", &[Some(j), Some(v)])?;
+    let (_, w) = npz.f64_with_shape("weights", &[Some(v), Some(j)])?;
+
+    let uv = match (npz.get("vt"), npz.get("ft")) {
+        (Some(_), Some(_)) => {
+            let (_, coords) = npz.f64_with_shape("vt", &[None, Some(2)])?;
+            let coords: Vec<[f32; 2]> = coords.chunks_exact(2).map(|c| [c[0] as f32, c[1] as f32]).collect();
+            let uv_faces = index_triples(npz, "ft", coords.len())?;
+            Some(UvLayout { coords, faces: uv_faces })
+        }
+        _ => None,
+    };
+    let gender = strings(npz, "gender").into_iter().next().unwrap_or_else(|| "neutral".into());
+    let extras: BTreeMap<_, _> = npz
+        .keys()
+        .filter(|k| !CORE_KEYS.contains(k))
+        .map(|k| (k.to_string(), npz.get(k).expect("listed key").clone()))
+        .collect();
+    let name = path.display().to_string();
+    BodyModel::new(BodyModelParts {
+        name,
+        gender,
+        v_template,
+        faces,
+        uv,
+        shapedirs,
+        num_betas: file_betas,
+        num_expression,
+        posedirs,
+        j_regressor: jr.iter().map(|&x| x as f32).collect(),
+        parents,
+        weights: w.iter().map(|&x| x as f32).collect(),
+        joint_names: strings(npz, "joint_names"),
+        shape_names: strings(npz, "shape_names"),
+        extras,
+    })
+    .and_then(|m| match num_betas {
+        Some(n) => m.with_num_betas(n),
+        None => Ok(m),
+    })
+}
+
+/// Loads a SMPL-family `.npz` model, keeping `num_betas` shape components (all when `None`).
+pub fn load_npz(path: &Path, num_betas: Option<usize>) -> Result<BodyModel, BodyError> {
+    if path.extension().is_some_and(|e| e == "pkl") {
+        return Err(BodyError::input(
+            path.display().to_string(),
+            "pickle files are read through a one-time conversion to .npz; see `mannequin body info --help`",
+        ));
+    }
+    parse_model(&Npz::read(path)?, num_betas)
+}

@@ -1,0 +1,125 @@
+//! Bad model and motion files give one-line errors that name the file and the field; never a panic.
+
+mod common;
+
+use std::path::PathBuf;
+
+use mannequin_body::{Motion, load_npz, parse_model};
+use mannequin_io::{NpyArray, Npz, NpzWriter};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mq-body-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A valid small SMPL-format model as an editable list of arrays.
+fn model_arrays() -> Vec<(String, NpyArray)> {
+    let bytes = common::random_model::random_model_npz(24, 4, 6, 8);
+    let npz = Npz::from_bytes("m.npz".into(), &bytes).unwrap();
+    npz.keys().map(|k| (k.to_string(), npz.get(k).unwrap().clone())).collect()
+}
+
+fn write(path: &PathBuf, arrays: &[(String, NpyArray)]) {
+    let mut w = NpzWriter::new();
+    for (k, a) in arrays {
+        w.add(k, a.clone());
+    }
+    w.write(path).unwrap();
+}
+
+fn one_line(msg: &str, file: &str, field: &str) {
+    assert!(!msg.contains('\n'), "not one line: {msg}");
+    assert!(msg.contains(file), "no file name in: {msg}");
+    assert!(msg.contains(field), "no field '{field}' in: {msg}");
+}
+
+#[test]
+fn missing_key_names_file_and_key() {
+    let dir = temp_dir("missing");
+    let path = dir.join("no_weights.npz");
+    let arrays: Vec<_> = model_arrays().into_iter().filter(|(k, _)| k != "weights").collect();
+    write(&path, &arrays);
+    let msg = load_npz(&path, None).unwrap_err().to_string();
+    one_line(&msg, "no_weights.npz", "weights");
+}
+
+#[test]
+fn wrong_shape_names_field_and_expected_shape() {
+    let dir = temp_dir("shape");
+    let path = dir.join("bad_shape.npz");
+    let mut arrays = model_arrays();
+    for (k, a) in arrays.iter_mut() {
+        if k == "J_regressor" {
+            a.shape = vec![a.shape[1], a.shape[0]];
+        }
+    }
+    write(&path, &arrays);
+    let msg = load_npz(&path, None).unwrap_err().to_string();
+    one_line(&msg, "bad_shape.npz", "J_regressor");
+    assert!(msg.contains("expected shape (24, 48)"), "{msg}");
+}
+
+#[test]
+fn too_many_betas_requested() {
+    let bytes = common::random_model::random_model_npz(24, 4, 6, 8);
+    let msg = parse_model(&Npz::from_bytes("few.npz".into(), &bytes).unwrap(), Some(10)).unwrap_err().to_string();
+    one_line(&msg, "few.npz", "shapedirs");
+}
+
+#[test]
+fn truncated_npz_is_a_clean_error() {
+    let dir = temp_dir("trunc");
+    let full = common::random_model::random_model_npz(24, 4, 6, 8);
+    for cut in [0, 20, full.len() / 3, full.len() - 10] {
+        let path = dir.join(format!("cut_{cut}.npz"));
+        std::fs::write(&path, &full[..cut]).unwrap();
+        let msg = load_npz(&path, None).unwrap_err().to_string();
+        one_line(&msg, &format!("cut_{cut}.npz"), "");
+    }
+}
+
+fn amass(path: &PathBuf, width: usize, poses: Vec<f64>) {
+    let frames = poses.len() / width;
+    let mut w = NpzWriter::new();
+    w.add("poses", NpyArray::f64(vec![frames, width], poses))
+        .add("trans", NpyArray::f64(vec![frames, 3], vec![0.0; frames * 3]))
+        .add("betas", NpyArray::f64(vec![16], vec![0.0; 16]))
+        .add("mocap_framerate", NpyArray::f64(vec![], vec![60.0]));
+    w.write(path).unwrap();
+}
+
+#[test]
+fn nan_in_a_pose_names_file_field_and_frame() {
+    let dir = temp_dir("nan");
+    let path = dir.join("nan_walk.npz");
+    let mut poses = vec![0.1; 3 * 156];
+    poses[156 + 40] = f64::NAN;
+    amass(&path, 156, poses);
+    let msg = Motion::read(&path).unwrap_err().to_string();
+    one_line(&msg, "nan_walk.npz", "poses");
+    assert!(msg.contains("frame 1"), "{msg}");
+}
+
+#[test]
+fn motion_with_unmappable_joint_count_is_rejected() {
+    let dir = temp_dir("joints");
+    let path = dir.join("odd.npz");
+    amass(&path, 30, vec![0.0; 60]);
+    let motion = Motion::read(&path).unwrap();
+    let bytes = common::random_model::random_model_npz(24, 4, 6, 8);
+    let model = parse_model(&Npz::from_bytes("m.npz".into(), &bytes).unwrap(), None).unwrap();
+    let msg = motion.poses_for(&model).unwrap_err().to_string();
+    one_line(&msg, "odd.npz", "poses");
+}
+
+#[test]
+fn missing_frame_rate_is_named() {
+    let dir = temp_dir("fps");
+    let path = dir.join("nofps.npz");
+    let mut w = NpzWriter::new();
+    w.add("poses", NpyArray::f64(vec![1, 72], vec![0.0; 72])).add("trans", NpyArray::f64(vec![1, 3], vec![0.0; 3]));
+    w.write(&path).unwrap();
+    let msg = Motion::read(&path).unwrap_err().to_string();
+    one_line(&msg, "nofps.npz", "mocap_framerate");
+}

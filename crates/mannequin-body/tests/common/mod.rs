@@ -1,0 +1,3 @@
+//! Test scaffolding shared by the body tests.
+
+pub mod random_model;
