@@ -1,0 +1,228 @@
+//! The pinhole camera, in the OpenCV convention: x right, y down, z forward, `K` in pixels,
+//! a rigid world→camera transform, and pixel centres at +0.5.
+
+use crate::SplatError;
+use crate::real::Real;
+
+/// A pinhole camera. Build it field by field or with [`Camera::look_at`], then
+/// [`Camera::validate`] (the renderer does this for you).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub width: usize,
+    pub height: usize,
+    /// Intrinsics in pixels, row-major `[[fx, 0, cx], [0, fy, cy], [0, 0, 1]]` (no skew).
+    pub intrinsic: [[f64; 3]; 3],
+    /// Rigid world→camera transform, row-major 4×4 with last row `[0, 0, 0, 1]`.
+    pub extrinsic: [[f64; 4]; 4],
+    /// Gaussians whose camera-space depth is not strictly between `near` and `far` are culled.
+    pub near: f64,
+    pub far: f64,
+}
+
+/// Largest accepted image side; beyond this tile indices and buffers would overflow.
+const MAX_SIDE: usize = 1 << 15;
+
+impl Camera {
+    /// A camera at `eye` looking at `target`, with world `up` pointing up in the image, a
+    /// horizontal field of view `fov_x` (radians), square pixels and the principal point at the
+    /// image centre; near 0.01, far 1e10.
+    pub fn look_at(
+        eye: [f64; 3],
+        target: [f64; 3],
+        up: [f64; 3],
+        fov_x: f64,
+        width: usize,
+        height: usize,
+    ) -> Self {
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        };
+        let unit = |a: [f64; 3]| {
+            let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            [a[0] / n, a[1] / n, a[2] / n]
+        };
+        // OpenCV axes: z forward, x = z × up (right), y = z × x (down).
+        let z = unit(sub(target, eye));
+        let x = unit(cross(z, up));
+        let y = cross(z, x);
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let f = 0.5 * width as f64 / (0.5 * fov_x).tan();
+        Camera {
+            width,
+            height,
+            intrinsic: [[f, 0.0, 0.5 * width as f64], [0.0, f, 0.5 * height as f64], [0.0, 0.0, 1.0]],
+            extrinsic: [
+                [x[0], x[1], x[2], -dot(x, eye)],
+                [y[0], y[1], y[2], -dot(y, eye)],
+                [z[0], z[1], z[2], -dot(z, eye)],
+                [0.0, 0.0, 0.0, 1.0],
+            ],
+            near: 0.01,
+            far: 1e10,
+        }
+    }
+
+    /// Checks that the camera can form an image, with a message naming the faulty part.
+    pub fn validate(&self) -> Result<(), SplatError> {
+        let err = |m: String| Err(SplatError::Camera(m));
+        if self.width == 0 || self.height == 0 {
+            return err(format!("image size {}×{} is empty", self.width, self.height));
+        }
+        if self.width > MAX_SIDE || self.height > MAX_SIDE {
+            return err(format!(
+                "image size {}×{} exceeds {MAX_SIDE} pixels a side",
+                self.width, self.height
+            ));
+        }
+        let k = &self.intrinsic;
+        if k.iter().flatten().any(|v| !v.is_finite()) {
+            return err(format!("intrinsic K has a non-finite entry: {k:?}"));
+        }
+        if !(k[0][0] > 0.0 && k[1][1] > 0.0) {
+            return err(format!(
+                "intrinsic K needs positive focal lengths, found fx={} fy={}",
+                k[0][0], k[1][1]
+            ));
+        }
+        if k[0][1] != 0.0 || k[1][0] != 0.0 || k[2] != [0.0, 0.0, 1.0] {
+            return err(format!("intrinsic K must be [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], found {k:?}"));
+        }
+        let e = &self.extrinsic;
+        if e.iter().flatten().any(|v| !v.is_finite()) {
+            return err(format!("extrinsic has a non-finite entry: {e:?}"));
+        }
+        if e[3] != [0.0, 0.0, 0.0, 1.0] {
+            return err(format!("extrinsic last row must be [0, 0, 0, 1], found {:?}", e[3]));
+        }
+        // R Rᵀ = I and det R = +1, within what a float-stored rotation keeps.
+        for i in 0..3 {
+            for j in 0..3 {
+                let d: f64 = (0..3).map(|k| e[i][k] * e[j][k]).sum::<f64>() - if i == j { 1.0 } else { 0.0 };
+                if d.abs() > 1e-4 {
+                    return err(format!(
+                        "extrinsic rotation is not orthonormal (R Rᵀ[{i}][{j}] off by {d:.2e})"
+                    ));
+                }
+            }
+        }
+        let det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1])
+            - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
+            + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+        if det < 0.0 {
+            return err("extrinsic rotation is a reflection (det = -1)".into());
+        }
+        if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near) {
+            return err(format!("need 0 < near < far, found near={} far={}", self.near, self.far));
+        }
+        Ok(())
+    }
+
+    /// The camera centre in world space, `−Rᵀ t`.
+    pub fn centre(&self) -> [f64; 3] {
+        let e = &self.extrinsic;
+        [0, 1, 2].map(|j| -(0..3).map(|i| e[i][j] * e[i][3]).sum::<f64>())
+    }
+
+    /// Number of 16×16 tiles across and down.
+    pub fn tiles(&self) -> (usize, usize) {
+        (self.width.div_ceil(crate::TILE), self.height.div_ceil(crate::TILE))
+    }
+}
+
+/// The camera converted once to the renderer's scalar type, with gsplat's frustum limits for the
+/// projection Jacobian precomputed.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CameraParams<T> {
+    pub fx: T,
+    pub fy: T,
+    pub cx: T,
+    pub cy: T,
+    /// World→camera rotation, row-major.
+    pub r: [T; 9],
+    pub t: [T; 3],
+    pub centre: [T; 3],
+    pub near: T,
+    pub far: T,
+    pub width: T,
+    pub height: T,
+    /// `x/z` is clamped to `[−lim_x_neg, lim_x_pos]` inside the Jacobian (1.3× the frustum).
+    pub lim_x: (T, T),
+    pub lim_y: (T, T),
+}
+
+impl<T: Real> CameraParams<T> {
+    pub fn new(cam: &Camera) -> Self {
+        let k = &cam.intrinsic;
+        let e = &cam.extrinsic;
+        let (w, h) = (cam.width as f64, cam.height as f64);
+        let (fx, fy, cx, cy) = (k[0][0], k[1][1], k[0][2], k[1][2]);
+        let (tan_x, tan_y) = (0.5 * w / fx, 0.5 * h / fy);
+        let c = cam.centre();
+        let t = T::from_f64;
+        CameraParams {
+            fx: t(fx),
+            fy: t(fy),
+            cx: t(cx),
+            cy: t(cy),
+            r: [e[0][0], e[0][1], e[0][2], e[1][0], e[1][1], e[1][2], e[2][0], e[2][1], e[2][2]].map(t),
+            t: [e[0][3], e[1][3], e[2][3]].map(t),
+            centre: c.map(t),
+            near: t(cam.near),
+            far: t(cam.far.min(f64::MAX)),
+            width: t(w),
+            height: t(h),
+            lim_x: (t(cx / fx + 0.3 * tan_x), t((w - cx) / fx + 0.3 * tan_x)),
+            lim_y: (t(cy / fy + 0.3 * tan_y), t((h - cy) / fy + 0.3 * tan_y)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn good() -> Camera {
+        Camera::look_at([0.0, 1.0, 2.5], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0], 0.8, 64, 48)
+    }
+
+    #[test]
+    fn look_at_puts_the_target_at_the_principal_point_and_up_at_the_top() {
+        let cam = good();
+        cam.validate().unwrap();
+        let e = cam.extrinsic;
+        let to_cam = |p: [f64; 3]| [0, 1, 2].map(|i| (0..3).map(|j| e[i][j] * p[j]).sum::<f64>() + e[i][3]);
+        let t = to_cam([0.0, 1.0, 0.0]);
+        assert!(t[0].abs() < 1e-12 && t[1].abs() < 1e-12 && (t[2] - 2.5).abs() < 1e-12);
+        // A point above the target has negative camera y (image up).
+        assert!(to_cam([0.0, 1.5, 0.0])[1] < 0.0);
+        let c = cam.centre();
+        assert!((c[0]).abs() < 1e-12 && (c[1] - 1.0).abs() < 1e-12 && (c[2] - 2.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_cameras_are_rejected_with_the_reason() {
+        let mut c = good();
+        c.width = 0;
+        assert!(c.validate().unwrap_err().to_string().contains("empty"));
+        let mut c = good();
+        c.intrinsic[0][0] = 0.0;
+        assert!(c.validate().unwrap_err().to_string().contains("focal"));
+        let mut c = good();
+        c.intrinsic[1][1] = f64::NAN;
+        assert!(c.validate().unwrap_err().to_string().contains("non-finite"));
+        let mut c = good();
+        c.extrinsic[0][0] *= 2.0;
+        assert!(c.validate().unwrap_err().to_string().contains("orthonormal"));
+        let mut c = good();
+        c.extrinsic[0] = c.extrinsic[0].map(|v| -v);
+        c.extrinsic[0][3] = -c.extrinsic[0][3];
+        assert!(c.validate().unwrap_err().to_string().contains("reflection"));
+        let mut c = good();
+        c.near = 0.0;
+        assert!(c.validate().unwrap_err().to_string().contains("near"));
+        let mut c = good();
+        c.intrinsic[0][1] = 1.0;
+        assert!(c.validate().unwrap_err().to_string().contains("must be"));
+    }
+}

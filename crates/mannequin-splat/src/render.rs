@@ -1,0 +1,398 @@
+//! The CPU renderer: projection, binning, per-tile compositing, and the backward pass that
+//! replays it. Tiles run in parallel (rayon); each worker reuses its scratch, so there is no
+//! allocation per pixel or per tile.
+
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+
+use crate::camera::{Camera, CameraParams};
+use crate::composite::{Packed, Rule, TILE_PIXELS, TileOut, TileRect, composite_tile, field};
+use crate::composite_vjp::{Replay, SCREEN_GRADS, TileGrads, composite_tile_vjp};
+use crate::gaussians::{GaussianGrads, Gaussians};
+use crate::project::{GradRow, ScreenGrad, project, project_vjp};
+use crate::real::Real;
+use crate::tiles::{Tiles, bin};
+use crate::{SplatError, TILE, sh};
+
+/// Alpha below which expected depth is not divided further (as gsplat's `clamp_min(1e-10)`).
+const MIN_ALPHA_FOR_DEPTH: f64 = 1e-10;
+
+/// How pixels are composed. The defaults are the 3DGS rules.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Background, one value per channel; empty means zeros.
+    pub background: Vec<f64>,
+    /// A Gaussian is skipped at a pixel where its alpha is below this (1/255).
+    pub alpha_threshold: f64,
+    /// Alpha is capped here (0.99).
+    pub max_alpha: f64,
+    /// A pixel stops before the Gaussian that would bring its transmittance to this or below (1e-4).
+    pub min_transmittance: f64,
+    /// Also return how many Gaussians each pixel composited.
+    pub count_contributors: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            background: Vec::new(),
+            alpha_threshold: 1.0 / 255.0,
+            max_alpha: 0.99,
+            min_transmittance: 1e-4,
+            count_contributors: false,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// The same rule without the hard cutoffs (no alpha threshold, no early stop, so no screen
+    /// extent either): the image is then a smooth function of every parameter, which is what
+    /// finite-difference checks need. Alpha is still capped.
+    pub fn without_cutoffs(mut self) -> Self {
+        self.alpha_threshold = 0.0;
+        self.min_transmittance = 0.0;
+        self
+    }
+
+    fn validate(&self, channels: usize) -> Result<(), SplatError> {
+        let err = |m: String| Err(SplatError::Options(m));
+        if !self.background.is_empty() && self.background.len() != channels {
+            return err(format!("background has {} values for {channels} channels", self.background.len()));
+        }
+        if self.background.iter().any(|v| !v.is_finite()) {
+            return err(format!("background {:?} is not finite", self.background));
+        }
+        if !(0.0..1.0).contains(&self.alpha_threshold) {
+            return err(format!("alpha_threshold {} is outside [0, 1)", self.alpha_threshold));
+        }
+        if !(self.max_alpha > 0.0 && self.max_alpha < 1.0) {
+            return err(format!("max_alpha {} is outside (0, 1)", self.max_alpha));
+        }
+        if !(0.0..1.0).contains(&self.min_transmittance) {
+            return err(format!("min_transmittance {} is outside [0, 1)", self.min_transmittance));
+        }
+        Ok(())
+    }
+
+    fn rule<T: Real>(&self) -> Rule<T> {
+        Rule {
+            threshold: T::from_f64(self.alpha_threshold),
+            max_alpha: T::from_f64(self.max_alpha),
+            min_transmittance: T::from_f64(self.min_transmittance),
+        }
+    }
+
+    fn background_of<T: Real>(&self, channels: usize) -> Vec<T> {
+        (0..channels).map(|c| T::from_f64(self.background.get(c).copied().unwrap_or(0.0))).collect()
+    }
+}
+
+/// What [`render`] produces. Images are planar, row-major, with pixel `(x, y)` at `y * width + x`.
+#[derive(Clone, Debug)]
+pub struct RenderOutput<T> {
+    pub width: usize,
+    pub height: usize,
+    pub channels: usize,
+    /// `C × H × W` composited colour or features, background included.
+    pub image: Vec<T>,
+    /// `H × W` accumulated opacity `1 − T_N`.
+    pub alpha: Vec<T>,
+    /// `H × W` expected depth `Σ wᵢ zᵢ / alpha` (camera z), 0 where nothing was drawn.
+    pub depth: Vec<T>,
+    /// `H × W` number of Gaussians composited per pixel, if asked for.
+    pub count: Option<Vec<u32>>,
+    /// Gaussians skipped because a parameter was NaN or infinite.
+    pub skipped: usize,
+    pub(crate) saved: Saved<T>,
+}
+
+/// What [`backward`] needs from the forward pass besides the images.
+#[derive(Clone, Debug)]
+pub(crate) struct Saved<T> {
+    pub prep: Prepared<T>,
+    /// `H × W` length of the pixel's tile list that compositing consumed; the backward pass
+    /// replays exactly that much.
+    pub last: Vec<u32>,
+}
+
+/// Gradients of a scalar loss with respect to the outputs of [`render`]; `None` means zero.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OutputGrads<'a, T> {
+    pub image: Option<&'a [T]>,
+    pub alpha: Option<&'a [T]>,
+    pub depth: Option<&'a [T]>,
+}
+
+/// What both passes derive from the inputs before compositing; [`render`] keeps it in its output
+/// so that [`backward`] does not redo it.
+#[derive(Clone, Debug)]
+pub(crate) struct Prepared<T> {
+    pub packed: Packed<T>,
+    pub tiles: Tiles,
+}
+
+fn prepare<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+) -> Result<(Prepared<T>, usize), SplatError> {
+    camera.validate()?;
+    g.validate_shapes()?;
+    g.validate_values()?;
+    opts.validate(g.channels())?;
+    let projection = project(g, &CameraParams::new(camera), opts.alpha_threshold);
+    let tiles = bin(&projection, g.opacities, opts.alpha_threshold, camera.width, camera.height);
+    let packed = Packed::new(&projection, g.opacities, g.channels(), opts.alpha_threshold, &tiles.order);
+    Ok((Prepared { packed, tiles }, projection.skipped))
+}
+
+/// Screen-space projection alone (means, conics, depths, radii, colours), for inspection and for
+/// checks against other implementations.
+pub fn project_gaussians<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+) -> Result<crate::Projection<T>, SplatError> {
+    camera.validate()?;
+    g.validate_shapes()?;
+    g.validate_values()?;
+    opts.validate(g.channels())?;
+    Ok(project(g, &CameraParams::new(camera), opts.alpha_threshold))
+}
+
+/// Rearranges tile-major data (`planes` planes of 256 values per tile) into planar row-major
+/// images of `w × h`.
+fn untile<U: Copy + Default + Send + Sync>(
+    src: &[U],
+    planes: usize,
+    w: usize,
+    h: usize,
+    tiles_x: usize,
+) -> Vec<U> {
+    let mut dst = vec![U::default(); planes * w * h];
+    dst.par_chunks_mut(w).enumerate().for_each(|(row, out)| {
+        let (plane, y) = (row / h, row % h);
+        let (ty, r) = (y / TILE, y % TILE);
+        for (tx, seg) in out.chunks_mut(TILE).enumerate() {
+            let base = ((ty * tiles_x + tx) * planes + plane) * TILE_PIXELS + r * TILE;
+            seg.copy_from_slice(&src[base..base + seg.len()]);
+        }
+    });
+    dst
+}
+
+/// Renders the Gaussians through the camera.
+pub fn render<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+) -> Result<RenderOutput<T>, SplatError> {
+    let (prep, skipped) = prepare(g, camera, opts)?;
+    let (w, h, ch) = (camera.width, camera.height, g.channels());
+    let tiles = &prep.tiles;
+    let n_tiles = tiles.tiles_x * tiles.tiles_y;
+    let rule = opts.rule::<T>();
+    // Tile-major results, filled in parallel, then rearranged into planar images.
+    let mut t_color = vec![T::ZERO; n_tiles * ch * TILE_PIXELS];
+    let mut t_trans = vec![T::ONE; n_tiles * TILE_PIXELS];
+    let mut t_depth = vec![T::ZERO; n_tiles * TILE_PIXELS];
+    let mut t_last = vec![0u32; n_tiles * TILE_PIXELS];
+    let mut t_count = vec![0u32; n_tiles * TILE_PIXELS];
+    t_color
+        .par_chunks_mut(ch * TILE_PIXELS)
+        .zip(t_trans.par_chunks_mut(TILE_PIXELS))
+        .zip(t_depth.par_chunks_mut(TILE_PIXELS))
+        .zip(t_last.par_chunks_mut(TILE_PIXELS))
+        .zip(t_count.par_chunks_mut(TILE_PIXELS))
+        .enumerate()
+        .for_each_init(
+            || TileOut::new(ch),
+            |out, (tile, ((((col, tr), dep), last), count))| {
+                let rect = TileRect::new(tiles, tile, w, h);
+                composite_tile(rect, tiles.list(tile), &prep.packed, &rule, out);
+                col.copy_from_slice(&out.color);
+                tr.copy_from_slice(&out.transmittance);
+                dep.copy_from_slice(&out.depth);
+                last.copy_from_slice(&out.last);
+                count.copy_from_slice(&out.count);
+            },
+        );
+    let tx = tiles.tiles_x;
+    let transmittance = untile(&t_trans, 1, w, h, tx);
+    let bg = opts.background_of::<T>(ch);
+    let mut image = untile(&t_color, ch, w, h, tx);
+    image.par_chunks_mut(w * h).zip(bg.par_iter()).for_each(|(plane, &b)| {
+        for (v, &t) in plane.iter_mut().zip(&transmittance) {
+            *v += t * b;
+        }
+    });
+    let alpha: Vec<T> = transmittance.par_iter().map(|&t| T::ONE - t).collect();
+    let min_a = T::from_f64(MIN_ALPHA_FOR_DEPTH);
+    let mut depth = untile(&t_depth, 1, w, h, tx);
+    depth.par_iter_mut().zip(&alpha).for_each(|(d, &a)| *d = *d / a.max(min_a));
+    let last = untile(&t_last, 1, w, h, tx);
+    let count = opts.count_contributors.then(|| untile(&t_count, 1, w, h, tx));
+    Ok(RenderOutput {
+        width: w,
+        height: h,
+        channels: ch,
+        image,
+        alpha,
+        depth,
+        count,
+        skipped,
+        saved: Saved { prep, last },
+    })
+}
+
+/// Gradients of a loss with respect to every input, given the loss's gradients with respect to
+/// the outputs `out` of [`render`]. The inputs must be the ones `out` was rendered from: the
+/// projection and tile lists are taken from `out` rather than recomputed.
+pub fn backward<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    out: &RenderOutput<T>,
+    grads: &OutputGrads<T>,
+) -> Result<GaussianGrads<T>, SplatError> {
+    camera.validate()?;
+    g.validate_shapes()?;
+    g.validate_values()?;
+    opts.validate(g.channels())?;
+    let prep = &out.saved.prep;
+    let (w, h, ch) = (camera.width, camera.height, g.channels());
+    let npx = w * h;
+    if prep.tiles.order.iter().any(|&i| i as usize >= g.len()) || prep.packed.stride != field::COLOR + ch {
+        return Err(SplatError::Options(
+            "backward: the forward output was rendered from other Gaussians".into(),
+        ));
+    }
+    let check = |field: &'static str, len: usize, per: usize| {
+        if len == per * npx {
+            Ok(())
+        } else {
+            Err(SplatError::Shape { field, expected: per * npx, found: len })
+        }
+    };
+    check("forward image", out.image.len(), ch)?;
+    check("forward alpha", out.alpha.len(), 1)?;
+    check("forward depth", out.depth.len(), 1)?;
+    check("forward contributor ends", out.saved.last.len(), 1)?;
+    if let Some(d) = grads.image {
+        check("image gradient", d.len(), ch)?;
+    }
+    if let Some(d) = grads.alpha {
+        check("alpha gradient", d.len(), 1)?;
+    }
+    if let Some(d) = grads.depth {
+        check("depth gradient", d.len(), 1)?;
+    }
+    // Expected depth E = D / max(A, ε): pass its gradient on to D and A.
+    let min_a = T::from_f64(MIN_ALPHA_FOR_DEPTH);
+    let mut d_acc = vec![T::ZERO; npx];
+    let mut d_alpha = grads.alpha.map_or_else(|| vec![T::ZERO; npx], <[T]>::to_vec);
+    let mut depth_acc = vec![T::ZERO; npx];
+    if let Some(gd) = grads.depth {
+        (d_acc.par_iter_mut(), d_alpha.par_iter_mut(), depth_acc.par_iter_mut())
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(i, (da, dal, dacc))| {
+                let (a, e) = (out.alpha[i], out.depth[i]);
+                let am = a.max(min_a);
+                *dacc = e * am;
+                *da = gd[i] / am;
+                if a > min_a {
+                    *dal -= gd[i] * e / am;
+                }
+            });
+    } else {
+        depth_acc.par_iter_mut().enumerate().for_each(|(i, d)| *d = out.depth[i] * out.alpha[i].max(min_a));
+    }
+
+    let tiles = &prep.tiles;
+    let n = g.len();
+    let stride = SCREEN_GRADS + ch;
+    let rule = opts.rule::<T>();
+    // One dense accumulator per worker thread; a worker holds its own lock for a whole tile.
+    let workers = rayon::current_num_threads();
+    let visible = tiles.order.len();
+    let bufs: Vec<Mutex<Vec<T>>> =
+        (0..workers).map(|_| Mutex::new(vec![T::ZERO; visible * stride])).collect();
+    (0..tiles.tiles_x * tiles.tiles_y).into_par_iter().for_each_init(
+        || (TileGrads::new(ch), Replay::new(ch)),
+        |(px, replay), tile| {
+            let list = tiles.list(tile);
+            if list.is_empty() {
+                return;
+            }
+            let rect = TileRect::new(tiles, tile, w, h);
+            px.last.fill(0);
+            for r in 0..rect.h {
+                for c in 0..rect.w {
+                    let (y, x, p) = (rect.y0 + r, rect.x0 + c, r * TILE + c);
+                    let i = y * w + x;
+                    px.last[p] = out.saved.last[i];
+                    px.transmittance[p] = T::ONE - out.alpha[i];
+                    px.d_alpha[p] = d_alpha[i];
+                    px.d_depth[p] = d_acc[i];
+                    px.depth[p] = depth_acc[i];
+                    for k in 0..ch {
+                        px.color[k * TILE_PIXELS + p] = out.image[k * npx + i];
+                        px.d_color[k * TILE_PIXELS + p] = grads.image.map_or(T::ZERO, |d| d[k * npx + i]);
+                    }
+                }
+            }
+            let slot = rayon::current_thread_index().unwrap_or(0) % workers;
+            let mut buf = bufs[slot].lock().unwrap_or_else(|e| e.into_inner());
+            composite_tile_vjp(rect, list, &prep.packed, &rule, px, replay, |rank, v| {
+                let row = &mut buf[rank as usize * stride..(rank as usize + 1) * stride];
+                for (dst, s) in row.iter_mut().zip(v) {
+                    *dst += *s;
+                }
+            });
+        },
+    );
+    let bufs: Vec<Vec<T>> =
+        bufs.into_iter().map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
+    let mut rank = vec![u32::MAX; n];
+    for (r, &i) in tiles.order.iter().enumerate() {
+        rank[i as usize] = r as u32;
+    }
+
+    let cam = CameraParams::new(camera);
+    let mut out_grads = GaussianGrads::zeros_like(g);
+    let (rot_n, col_n) = (out_grads.rotations.len() / n.max(1), out_grads.colors.len() / n.max(1));
+    let GaussianGrads { means, rotations, scales, opacities, colors } = &mut out_grads;
+    means
+        .par_chunks_mut(3)
+        .zip(rotations.par_chunks_mut(rot_n.max(1)))
+        .zip(scales.par_chunks_mut(3))
+        .zip(opacities.par_chunks_mut(1))
+        .zip(colors.par_chunks_mut(col_n.max(1)))
+        .enumerate()
+        .for_each_init(
+            || (vec![T::ZERO; stride], vec![T::ZERO; sh::basis_len(sh::MAX_DEGREE)]),
+            |(sum, basis), (i, ((((m, r), s), o), c))| {
+                let at = rank[i] as usize;
+                if at == u32::MAX as usize {
+                    return;
+                }
+                sum.fill(T::ZERO);
+                for b in &bufs {
+                    for (acc, v) in sum.iter_mut().zip(&b[at * stride..(at + 1) * stride]) {
+                        *acc += *v;
+                    }
+                }
+                // Gaussians that reached no pixel have zero gradient.
+                if sum.iter().all(|&v| v == T::ZERO) {
+                    return;
+                }
+                let sg =
+                    ScreenGrad { mean2d: [sum[0], sum[1]], conic: [sum[2], sum[3], sum[4]], depth: sum[6] };
+                let row = GradRow { means: m, rotations: r, scales: s, opacity: o, colors: c };
+                project_vjp(g, &cam, i, &sg, &sum[SCREEN_GRADS..], sum[5], basis, row);
+            },
+        );
+    Ok(out_grads)
+}
