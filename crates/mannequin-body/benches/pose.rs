@@ -31,11 +31,15 @@ fn clip(model: &BodyModel) -> (Vec<f32>, Vec<f32>) {
 }
 
 fn smplx_seconds() -> Option<f64> {
-    let venv = std::env::var("ORACLE_VENV")
-        .unwrap_or_else(|_| format!("{}/.cache/mannequin-oracles", std::env::var("HOME").unwrap_or_default()));
+    let venv = std::env::var("ORACLE_VENV").unwrap_or_else(|_| {
+        format!("{}/.cache/mannequin-oracles", std::env::var("HOME").unwrap_or_default())
+    });
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tools/oracles/bench_smplx.py");
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
-    let out = Command::new(format!("{venv}/bin/python")).args([script, &FRAMES.to_string(), &threads.to_string()]).output().ok()?;
+    let out = Command::new(format!("{venv}/bin/python"))
+        .args([script, &FRAMES.to_string(), &threads.to_string()])
+        .output()
+        .ok()?;
     let text = String::from_utf8_lossy(&out.stdout);
     text.lines().find_map(|l| l.strip_prefix("smplx_seconds ")?.trim().parse().ok())
 }
@@ -51,8 +55,13 @@ fn bench(name: &str, model: &BodyModel) -> f64 {
     let single = pool.install(|| {
         best_of(1, || {
             (0..FRAMES)
-                .map(|f| pose_frames(model, &shaped, &poses[f * pl..(f + 1) * pl], &transl[3 * f..3 * f + 3]).unwrap())
-                .count()
+                .map(|f| {
+                    pose_frames(model, &shaped, &poses[f * pl..(f + 1) * pl], &transl[3 * f..3 * f + 3])
+                        .unwrap()
+                        .vertices
+                        .len()
+                })
+                .sum::<usize>()
         })
     });
     println!(
@@ -73,7 +82,11 @@ fn main() {
     bench("default body", &BodyModel::default_body());
     bench("default body (lod1)", &BodyModel::default_body_lod1());
     match smplx_seconds() {
-        Some(s) => println!("smplx (PyTorch CPU) SMPL-format: {:.1} ms  -> mannequin is {:.1}x faster (target >= 5x)", s * 1e3, s / ours),
+        Some(s) => println!(
+            "smplx (PyTorch CPU) SMPL-format: {:.1} ms  -> mannequin is {:.1}x faster (target >= 5x)",
+            s * 1e3,
+            s / ours
+        ),
         None => println!("smplx not installed (run tools/oracles env); no comparison this run"),
     }
 }

@@ -16,7 +16,8 @@ static LOD1: &[u8] = include_bytes!("../assets/default_body_lod1.npz");
 pub const DEFAULT_SPECS: [&str; 2] = ["default", "default-lod1"];
 
 fn embedded(name: &str, bytes: &[u8]) -> BodyModel {
-    let npz = Npz::from_bytes(format!("<embedded {name}>").into(), bytes).expect("the embedded default body is a valid npz");
+    let npz = Npz::from_bytes(format!("<embedded {name}>").into(), bytes)
+        .expect("the embedded default body is a valid npz");
     parse_model(&npz, None).expect("the embedded default body is a valid model")
 }
 

@@ -5,7 +5,11 @@ use glam::{Affine3A, Mat3, Vec3, Vec3A};
 
 /// World transforms of every joint, given local rotations and rest joint positions.
 /// Parents must come before children.
-pub fn world_transforms(parents: &[Option<usize>], rotations: &[Mat3], rest_joints: &[Vec3]) -> Vec<Affine3A> {
+pub fn world_transforms(
+    parents: &[Option<usize>],
+    rotations: &[Mat3],
+    rest_joints: &[Vec3],
+) -> Vec<Affine3A> {
     let mut world: Vec<Affine3A> = Vec::with_capacity(parents.len());
     for (k, parent) in parents.iter().enumerate() {
         let local_offset = match parent {

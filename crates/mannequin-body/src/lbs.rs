@@ -47,7 +47,10 @@ impl PosedFrames {
 pub fn shape_body(model: &BodyModel, shape: &[f32]) -> Result<ShapedBody, BodyError> {
     let n = model.num_shape_coeffs();
     if shape.len() > n {
-        return Err(BodyError::input("shape", format!("{} coefficients given, the model has {n}", shape.len())));
+        return Err(BodyError::input(
+            "shape",
+            format!("{} coefficients given, the model has {n}", shape.len()),
+        ));
     }
     if let Some(i) = shape.iter().position(|x| !x.is_finite()) {
         return Err(BodyError::input("shape", format!("coefficient {i} is not finite")));
@@ -68,25 +71,37 @@ pub fn shape_body(model: &BodyModel, shape: &[f32]) -> Result<ShapedBody, BodyEr
 pub fn regress_joints(model: &BodyModel, vertices: &[f32]) -> Vec<Vec3> {
     let reg = model.j_regressor();
     (0..reg.rows())
-        .map(|j| reg.row(j).fold(Vec3::ZERO, |acc, (v, w)| acc + w * Vec3::from_slice(&vertices[3 * v..3 * v + 3])))
+        .map(|j| {
+            reg.row(j).fold(Vec3::ZERO, |acc, (v, w)| acc + w * Vec3::from_slice(&vertices[3 * v..3 * v + 3]))
+        })
         .collect()
 }
 
 /// Checks a pose/translation batch and returns its frame count.
 fn frame_count(model: &BodyModel, poses: &[f32], transl: &[f32]) -> Result<usize, BodyError> {
     let pl = model.pose_len();
-    if poses.is_empty() || poses.len() % pl != 0 {
+    if poses.is_empty() || !poses.len().is_multiple_of(pl) {
         return Err(BodyError::input(
             "pose",
-            format!("expected a multiple of {pl} values ({} joints × 3), found {}", model.num_joints(), poses.len()),
+            format!(
+                "expected a multiple of {pl} values ({} joints × 3), found {}",
+                model.num_joints(),
+                poses.len()
+            ),
         ));
     }
     let f = poses.len() / pl;
     if transl.len() != 3 * f {
-        return Err(BodyError::input("translation", format!("expected {} values (3 per frame), found {}", 3 * f, transl.len())));
+        return Err(BodyError::input(
+            "translation",
+            format!("expected {} values (3 per frame), found {}", 3 * f, transl.len()),
+        ));
     }
     if let Some(i) = poses.iter().position(|x| !x.is_finite()) {
-        return Err(BodyError::input("pose", format!("frame {}, joint {} is not finite", i / pl, (i % pl) / 3)));
+        return Err(BodyError::input(
+            "pose",
+            format!("frame {}, joint {} is not finite", i / pl, (i % pl) / 3),
+        ));
     }
     if let Some(i) = transl.iter().position(|x| !x.is_finite()) {
         return Err(BodyError::input("translation", format!("frame {} is not finite", i / 3)));
@@ -178,6 +193,11 @@ pub fn pose_frames(
 }
 
 /// One-call forward for a batch that shares one shape.
-pub fn forward(model: &BodyModel, shape: &[f32], poses: &[f32], transl: &[f32]) -> Result<PosedFrames, BodyError> {
+pub fn forward(
+    model: &BodyModel,
+    shape: &[f32],
+    poses: &[f32],
+    transl: &[f32],
+) -> Result<PosedFrames, BodyError> {
     pose_frames(model, &shape_body(model, shape)?, poses, transl)
 }

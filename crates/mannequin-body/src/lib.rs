@@ -10,15 +10,15 @@ pub mod model;
 pub mod motion;
 pub mod named_pose;
 pub mod rodrigues;
-pub mod walk_cycle;
 pub mod skinned_export;
 pub mod smpl_npz;
+pub mod walk_cycle;
 
 pub use error::BodyError;
-pub use lbs_tensor::{BodyTensors, PosedTensors, forward_tensors, rodrigues_tensor};
 pub use lbs::{PosedFrames, ShapedBody, forward, pose_frames, shape_body};
+pub use lbs_tensor::{BodyTensors, PosedTensors, forward_tensors, rodrigues_tensor};
+pub use model::{BodyModel, BodyModelParts, ModelFamily};
 pub use motion::Motion;
 pub use named_pose::{POSE_NAMES, named_pose};
-pub use model::{BodyModel, BodyModelParts, ModelFamily};
 pub use skinned_export::{skeletal_animation, skinned_body};
 pub use smpl_npz::{load_npz, parse_model};

@@ -163,30 +163,57 @@ impl BodyModel {
         for (k, parent) in p.parents.iter().enumerate() {
             match parent {
                 None if k != 0 => {
-                    return Err(bad(n, "kintree_table", format!("joint {k} has no parent; only joint 0 may be the root")));
+                    return Err(bad(
+                        n,
+                        "kintree_table",
+                        format!("joint {k} has no parent; only joint 0 may be the root"),
+                    ));
                 }
                 Some(_) if k == 0 => {
                     return Err(bad(n, "kintree_table", "joint 0 must be the root".into()));
                 }
                 Some(q) if *q >= k => {
-                    return Err(bad(n, "kintree_table", format!("joint {k} has parent {q}; parents must come first")));
+                    return Err(bad(
+                        n,
+                        "kintree_table",
+                        format!("joint {k} has parent {q}; parents must come first"),
+                    ));
                 }
                 _ => {}
             }
         }
         let shape_len = p.num_betas + p.num_expression;
         if p.shapedirs.len() != shape_len * 3 * v {
-            return Err(bad(n, "shapedirs", format!("expected {shape_len} components of {v}×3, found {} values", p.shapedirs.len())));
+            return Err(bad(
+                n,
+                "shapedirs",
+                format!("expected {shape_len} components of {v}×3, found {} values", p.shapedirs.len()),
+            ));
         }
         let pose_features = 9 * (j - 1);
         if !p.posedirs.is_empty() && p.posedirs.len() != pose_features * 3 * v {
-            return Err(bad(n, "posedirs", format!("expected ({v}, 3, {pose_features}) or an empty basis, found {} values", p.posedirs.len())));
+            return Err(bad(
+                n,
+                "posedirs",
+                format!(
+                    "expected ({v}, 3, {pose_features}) or an empty basis, found {} values",
+                    p.posedirs.len()
+                ),
+            ));
         }
         if p.j_regressor.len() != j * v {
-            return Err(bad(n, "J_regressor", format!("expected shape ({j}, {v}), found {} values", p.j_regressor.len())));
+            return Err(bad(
+                n,
+                "J_regressor",
+                format!("expected shape ({j}, {v}), found {} values", p.j_regressor.len()),
+            ));
         }
         if p.weights.len() != v * j {
-            return Err(bad(n, "weights", format!("expected shape ({v}, {j}), found {} values", p.weights.len())));
+            return Err(bad(
+                n,
+                "weights",
+                format!("expected shape ({v}, {j}), found {} values", p.weights.len()),
+            ));
         }
         for (field, values) in [
             ("shapedirs", &p.shapedirs),
@@ -300,7 +327,11 @@ impl BodyModel {
     /// wants to fit.
     pub fn with_num_betas(mut self, n: usize) -> Result<Self, BodyError> {
         if n > self.num_betas {
-            return Err(bad(&self.name, "shapedirs", format!("{n} betas requested but the model has {}", self.num_betas)));
+            return Err(bad(
+                &self.name,
+                "shapedirs",
+                format!("{n} betas requested but the model has {}", self.num_betas),
+            ));
         }
         let len = 3 * self.num_vertices();
         self.shapedirs.drain(n * len..self.num_betas * len);

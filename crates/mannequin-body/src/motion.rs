@@ -42,7 +42,9 @@ fn scalar_f64(npz: &Npz, key: &str) -> Result<f64, BodyError> {
 
 fn check_finite(npz: &Npz, key: &str, values: &[f32], per_frame: usize) -> Result<(), BodyError> {
     match values.iter().position(|x| !x.is_finite()) {
-        Some(i) => Err(npz.field_error(key, format!("frame {} holds a non-finite value", i / per_frame.max(1))).into()),
+        Some(i) => Err(npz
+            .field_error(key, format!("frame {} holds a non-finite value", i / per_frame.max(1)))
+            .into()),
         None => Ok(()),
     }
 }
@@ -56,20 +58,30 @@ impl Motion {
     pub fn from_amass(npz: &Npz) -> Result<Self, BodyError> {
         let (shape, poses) = npz.f64_with_shape("poses", &[None, None])?;
         let (frames, width) = (shape[0], shape[1]);
-        if width % 3 != 0 || width == 0 {
-            return Err(npz.field_error("poses", format!("expected 3 values per joint, found {width} per frame")).into());
+        if !width.is_multiple_of(3) || width == 0 {
+            return Err(npz
+                .field_error("poses", format!("expected 3 values per joint, found {width} per frame"))
+                .into());
         }
         let (_, trans) = npz.f64_with_shape("trans", &[Some(frames), Some(3)])?;
         let betas = match npz.get("betas") {
             Some(a) => a.to_f64().ok_or_else(|| npz.field_error("betas", "expected numbers"))?,
             None => Vec::new(),
         };
-        let fps_key = ["mocap_framerate", "mocap_frame_rate"].into_iter().find(|k| npz.contains(k)).ok_or_else(|| {
-            npz.field_error("mocap_framerate", "missing: expected 'mocap_framerate' or 'mocap_frame_rate'")
-        })?;
+        let fps_key = ["mocap_framerate", "mocap_frame_rate"]
+            .into_iter()
+            .find(|k| npz.contains(k))
+            .ok_or_else(|| {
+                npz.field_error(
+                    "mocap_framerate",
+                    "missing: expected 'mocap_framerate' or 'mocap_frame_rate'",
+                )
+            })?;
         let fps = scalar_f64(npz, fps_key)? as f32;
         if !(fps.is_finite() && fps > 0.0) {
-            return Err(npz.field_error(fps_key, format!("expected a positive frame rate, found {fps}")).into());
+            return Err(npz
+                .field_error(fps_key, format!("expected a positive frame rate, found {fps}"))
+                .into());
         }
         let gender = match npz.get("gender").map(|a| &a.data) {
             Some(NpyData::Str(s)) => s.first().cloned(),
@@ -126,11 +138,20 @@ impl Motion {
     pub fn write_amass(&self, path: &Path) -> Result<(), BodyError> {
         let f = self.num_frames();
         let mut w = NpzWriter::new();
-        w.add("poses", NpyArray::f64(vec![f, 3 * self.joints], self.poses.iter().map(|&x| x as f64).collect()))
-            .add("trans", NpyArray::f64(vec![f, 3], self.trans.iter().map(|&x| x as f64).collect()))
-            .add("betas", NpyArray::f64(vec![self.betas.len()], self.betas.iter().map(|&x| x as f64).collect()))
-            .add("mocap_framerate", NpyArray::f64(vec![], vec![self.fps as f64]))
-            .add("gender", NpyArray { shape: vec![], data: NpyData::Str(vec![self.gender.clone().unwrap_or("neutral".into())]) });
+        w.add(
+            "poses",
+            NpyArray::f64(vec![f, 3 * self.joints], self.poses.iter().map(|&x| x as f64).collect()),
+        )
+        .add("trans", NpyArray::f64(vec![f, 3], self.trans.iter().map(|&x| x as f64).collect()))
+        .add("betas", NpyArray::f64(vec![self.betas.len()], self.betas.iter().map(|&x| x as f64).collect()))
+        .add("mocap_framerate", NpyArray::f64(vec![], vec![self.fps as f64]))
+        .add(
+            "gender",
+            NpyArray {
+                shape: vec![],
+                data: NpyData::Str(vec![self.gender.clone().unwrap_or("neutral".into())]),
+            },
+        );
         Ok(w.write(path)?)
     }
 
@@ -149,7 +170,10 @@ impl Motion {
             return Err(BodyError::field(
                 &self.source,
                 "poses",
-                format!("{} joints per frame, but the model has {target} and no known mapping exists", self.joints),
+                format!(
+                    "{} joints per frame, but the model has {target} and no known mapping exists",
+                    self.joints
+                ),
             ));
         }
         let mut out = vec![0.0f32; self.num_frames() * 3 * target];

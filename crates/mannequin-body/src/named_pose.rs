@@ -73,7 +73,10 @@ pub fn named_pose(name: &str) -> Result<[f32; 72], BodyError> {
             set(&mut p, R_ELBOW, [0.0, 1.6, 0.0]);
         }
         other => {
-            return Err(BodyError::input("pose name", format!("unknown '{other}'; expected one of {}", POSE_NAMES.join(", "))));
+            return Err(BodyError::input(
+                "pose name",
+                format!("unknown '{other}'; expected one of {}", POSE_NAMES.join(", ")),
+            ));
         }
     }
     Ok(p)

@@ -24,7 +24,11 @@ pub fn rodrigues(r: [f32; 3]) -> Mat3 {
 pub fn axis_angle_quat(r: [f32; 3]) -> Quat {
     let v = Vec3::from(r);
     let theta = v.length();
-    if theta < SMALL_ANGLE { Quat::from_xyzw(0.5 * v.x, 0.5 * v.y, 0.5 * v.z, 1.0).normalize() } else { Quat::from_axis_angle(v / theta, theta) }
+    if theta < SMALL_ANGLE {
+        Quat::from_xyzw(0.5 * v.x, 0.5 * v.y, 0.5 * v.z, 1.0).normalize()
+    } else {
+        Quat::from_axis_angle(v / theta, theta)
+    }
 }
 
 /// Axis-angle vector of a rotation (inverse of [`rodrigues`] for angles below π).

@@ -26,19 +26,31 @@ pub fn skinned_body(model: &BodyModel, shape: &[f32]) -> Result<SkinnedMesh, Bod
 }
 
 /// F frames of axis-angle `poses` (F × 3J, the model's layout) and `trans` (F × 3) at `fps`.
-pub fn skeletal_animation(model: &BodyModel, poses: &[f32], trans: &[f32], fps: f32) -> Result<SkeletalAnimation, BodyError> {
+pub fn skeletal_animation(
+    model: &BodyModel,
+    poses: &[f32],
+    trans: &[f32],
+    fps: f32,
+) -> Result<SkeletalAnimation, BodyError> {
     let pl = model.pose_len();
-    if poses.len() % pl != 0 || poses.len() / pl != trans.len() / 3 {
+    if !poses.len().is_multiple_of(pl) || poses.len() / pl != trans.len() / 3 {
         return Err(BodyError::input(
             "motion",
-            format!("{} pose values and {} translations do not make whole frames of {} joints", poses.len(), trans.len() / 3, model.num_joints()),
+            format!(
+                "{} pose values and {} translations do not make whole frames of {} joints",
+                poses.len(),
+                trans.len() / 3,
+                model.num_joints()
+            ),
         ));
     }
     Ok(SkeletalAnimation {
         fps,
         local_rotations: poses
             .chunks_exact(pl)
-            .map(|frame| frame.chunks_exact(3).map(|r| axis_angle_quat([r[0], r[1], r[2]]).to_array()).collect())
+            .map(|frame| {
+                frame.chunks_exact(3).map(|r| axis_angle_quat([r[0], r[1], r[2]]).to_array()).collect()
+            })
             .collect(),
         root_translation: trans.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
     })

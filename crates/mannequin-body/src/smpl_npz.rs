@@ -59,7 +59,9 @@ fn index_triples(npz: &Npz, key: &str, bound: usize) -> Result<Vec<[u32; 3]>, Bo
     if a.shape.len() != 2 || a.shape[1] != 3 {
         return Err(npz.field_error(key, format!("expected shape (*, 3), found {:?}", a.shape)).into());
     }
-    let ints = a.to_i64().ok_or_else(|| npz.field_error(key, format!("expected integers, found {}", a.dtype_name())))?;
+    let ints = a
+        .to_i64()
+        .ok_or_else(|| npz.field_error(key, format!("expected integers, found {}", a.dtype_name())))?;
     if let Some(&bad) = ints.iter().find(|&&i| i < 0 || i as usize >= bound) {
         return Err(npz.field_error(key, format!("index {bad} is outside 0..{bound}")).into());
     }
@@ -79,10 +81,7 @@ fn parents(npz: &Npz) -> Result<Vec<Option<usize>>, BodyError> {
     if ids.iter().enumerate().any(|(k, &id)| id != k as i64) {
         return Err(npz.field_error(key, "row 1 must list the joints in order 0..J").into());
     }
-    Ok(ints[..j]
-        .iter()
-        .map(|&p| if p < 0 || p >= j as i64 { None } else { Some(p as usize) })
-        .collect())
+    Ok(ints[..j].iter().map(|&p| if p < 0 || p >= j as i64 { None } else { Some(p as usize) }).collect())
 }
 
 /// Reads a SMPL-family model from the bytes of an `.npz` file; `path` names it in errors.
@@ -90,7 +89,8 @@ pub fn parse_model(npz: &Npz, num_betas: Option<usize>) -> Result<BodyModel, Bod
     let path = npz.path.clone();
     let (_, vt) = npz.f64_with_shape("v_template", &[None, Some(3)])?;
     let v = vt.len() / 3;
-    let v_template: Vec<[f32; 3]> = vt.chunks_exact(3).map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]).collect();
+    let v_template: Vec<[f32; 3]> =
+        vt.chunks_exact(3).map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]).collect();
     let faces = index_triples(npz, "f", v)?;
     let parents = parents(npz)?;
     let j = parents.len();
@@ -98,8 +98,11 @@ pub fn parse_model(npz: &Npz, num_betas: Option<usize>) -> Result<BodyModel, Bod
     let (sd_shape, sd) = npz.f64_with_shape("shapedirs", &[Some(v), Some(3), None])?;
     let stored = sd_shape[2];
     let family_is_x = j == 55;
-    let (file_betas, num_expression) =
-        if family_is_x && stored > SMPLX_SHAPE_SPACE { (SMPLX_SHAPE_SPACE, stored - SMPLX_SHAPE_SPACE) } else { (stored, 0) };
+    let (file_betas, num_expression) = if family_is_x && stored > SMPLX_SHAPE_SPACE {
+        (SMPLX_SHAPE_SPACE, stored - SMPLX_SHAPE_SPACE)
+    } else {
+        (stored, 0)
+    };
     let shapedirs = component_major(&sd, v, stored);
     let posedirs = match npz.get("posedirs") {
         Some(a) if a.shape.len() == 3 && a.shape[2] == 0 => Vec::new(),

@@ -63,7 +63,8 @@ fn wrong_shape_names_field_and_expected_shape() {
 #[test]
 fn too_many_betas_requested() {
     let bytes = common::random_model::random_model_npz(24, 4, 6, 8);
-    let msg = parse_model(&Npz::from_bytes("few.npz".into(), &bytes).unwrap(), Some(10)).unwrap_err().to_string();
+    let msg =
+        parse_model(&Npz::from_bytes("few.npz".into(), &bytes).unwrap(), Some(10)).unwrap_err().to_string();
     one_line(&msg, "few.npz", "shapedirs");
 }
 
@@ -118,7 +119,8 @@ fn missing_frame_rate_is_named() {
     let dir = temp_dir("fps");
     let path = dir.join("nofps.npz");
     let mut w = NpzWriter::new();
-    w.add("poses", NpyArray::f64(vec![1, 72], vec![0.0; 72])).add("trans", NpyArray::f64(vec![1, 3], vec![0.0; 3]));
+    w.add("poses", NpyArray::f64(vec![1, 72], vec![0.0; 72]))
+        .add("trans", NpyArray::f64(vec![1, 3], vec![0.0; 3]));
     w.write(&path).unwrap();
     let msg = Motion::read(&path).unwrap_err().to_string();
     one_line(&msg, "nofps.npz", "mocap_framerate");

@@ -19,7 +19,12 @@ fn t2(values: &[f64], rows: usize, cols: usize, device: &Device) -> Tensor<2> {
 
 /// The four inputs (template, shape, pose, translation) as tensors of their shapes.
 fn leaves(x: &[Vec<f64>; 4], v: usize, n: usize, device: &Device) -> [Tensor<2>; 4] {
-    [t2(&x[0], v, 3, device), t2(&x[1], n, x[1].len() / n, device), t2(&x[2], n, x[2].len() / n, device), t2(&x[3], n, 3, device)]
+    [
+        t2(&x[0], v, 3, device),
+        t2(&x[1], n, x[1].len() / n, device),
+        t2(&x[2], n, x[2].len() / n, device),
+        t2(&x[3], n, 3, device),
+    ]
 }
 
 /// A fixed, non-symmetric scalar loss of the outputs.
@@ -32,8 +37,14 @@ fn loss(bt: &BodyTensors, inputs: [Tensor<2>; 4]) -> Tensor<1> {
     let pattern = |len: usize, a: usize, m: usize, shift: f64| -> Vec<f64> {
         (0..len).map(|i| ((i * a) % m) as f64 / m as f64 - shift).collect()
     };
-    let wv = Tensor::<3>::from_data(TensorData::new(pattern(n * v * 3, 7919, 13, 0.4), [n, v, 3]), (&device, DType::F64));
-    let wj = Tensor::<3>::from_data(TensorData::new(pattern(n * j * 3, 104729, 11, 0.5), [n, j, 3]), (&device, DType::F64));
+    let wv = Tensor::<3>::from_data(
+        TensorData::new(pattern(n * v * 3, 7919, 13, 0.4), [n, v, 3]),
+        (&device, DType::F64),
+    );
+    let wj = Tensor::<3>::from_data(
+        TensorData::new(pattern(n * j * 3, 104729, 11, 0.5), [n, j, 3]),
+        (&device, DType::F64),
+    );
     (out.vertices * wv).sum() + (out.joints.square() * wj).sum()
 }
 
@@ -71,7 +82,11 @@ fn gradients_match_central_differences() {
             };
             let fd = (at(h) - at(-h)) / (2.0 * h);
             let err = (g[i] - fd).abs();
-            assert!(err < 1e-6 * (1.0 + fd.abs()), "{name}[{i}]: autodiff {} vs finite difference {fd}", g[i]);
+            assert!(
+                err < 1e-6 * (1.0 + fd.abs()),
+                "{name}[{i}]: autodiff {} vs finite difference {fd}",
+                g[i]
+            );
         }
     }
 }

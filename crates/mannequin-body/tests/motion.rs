@@ -25,7 +25,10 @@ fn smplh_clip_maps_body_joints_and_rests_the_hands() {
         .add("trans", NpyArray::f64(vec![2, 3], vec![0.5; 6]))
         .add("betas", NpyArray::f64(vec![16], vec![0.1; 16]))
         .add("mocap_frame_rate", NpyArray::f64(vec![], vec![120.0]))
-        .add("gender", mannequin_io::NpyArray { shape: vec![], data: mannequin_io::NpyData::Str(vec!["female".into()]) });
+        .add(
+            "gender",
+            mannequin_io::NpyArray { shape: vec![], data: mannequin_io::NpyData::Str(vec!["female".into()]) },
+        );
     w.write(&path).unwrap();
     let m = Motion::read(&path).unwrap();
     assert_eq!((m.joints, m.fps, m.gender.as_deref(), m.betas.len()), (52, 120.0, Some("female"), 16));
@@ -65,7 +68,8 @@ fn resampling_halves_the_rate_and_slerps() {
         poses[f * 72 + 2] = 0.1 * f as f32;
         trans[f * 3] = f as f32;
     }
-    let m = Motion { source: "clip".into(), poses, joints: 24, trans, betas: vec![], fps: 60.0, gender: None };
+    let m =
+        Motion { source: "clip".into(), poses, joints: 24, trans, betas: vec![], fps: 60.0, gender: None };
     let half = m.resample(30.0).unwrap();
     assert_eq!(half.num_frames(), 3);
     assert!((half.poses[72 + 2] - 0.2).abs() < 1e-6);

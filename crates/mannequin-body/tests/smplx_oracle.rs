@@ -19,7 +19,8 @@ fn check_family(name: &str, family: ModelFamily, grid: (usize, usize)) {
     let joints = fx.require("joint_count").unwrap().to_i64().unwrap()[0] as usize;
     let components = fx.require("components").unwrap().to_i64().unwrap()[0] as usize;
     let bytes = common::random_model::random_model_npz(joints, components, grid.0, grid.1);
-    let model: BodyModel = parse_model(&Npz::from_bytes("random.npz".into(), &bytes).unwrap(), Some(10)).unwrap();
+    let model: BodyModel =
+        parse_model(&Npz::from_bytes("random.npz".into(), &bytes).unwrap(), Some(10)).unwrap();
     assert_eq!(model.family, family);
 
     let betas = f32s(&fx, "betas");

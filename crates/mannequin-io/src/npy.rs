@@ -129,8 +129,7 @@ fn parse_descr(descr: &str) -> Result<Descr, NpyError> {
         'S' | 'a' => Kind::Bytes,
         'O' => {
             return Err(NpyError::Format(
-                "object arrays (dtype 'O') hold pickled Python objects; save plain numeric arrays"
-                    .into(),
+                "object arrays (dtype 'O') hold pickled Python objects; save plain numeric arrays".into(),
             ));
         }
         _ => return Err(bad()),
@@ -151,9 +150,7 @@ fn parse_descr(descr: &str) -> Result<Descr, NpyError> {
 /// Extracts the value text after `'key':` in the header dict.
 fn header_field<'a>(header: &'a str, key: &str) -> Result<&'a str, NpyError> {
     let pat = format!("'{key}'");
-    let start = header
-        .find(&pat)
-        .ok_or_else(|| NpyError::Format(format!("header lacks '{key}'")))?;
+    let start = header.find(&pat).ok_or_else(|| NpyError::Format(format!("header lacks '{key}'")))?;
     let after = header[start + pat.len()..].trim_start();
     let after = after
         .strip_prefix(':')
@@ -168,20 +165,15 @@ fn parse_header(header: &str) -> Result<(Descr, bool, Vec<usize>), NpyError> {
         .next()
         .filter(|c| *c == '\'' || *c == '"')
         .ok_or_else(|| NpyError::Format("structured dtypes are not supported".into()))?;
-    let end = descr_txt[1..]
-        .find(quote)
-        .ok_or_else(|| NpyError::Format("unterminated 'descr'".into()))?;
+    let end = descr_txt[1..].find(quote).ok_or_else(|| NpyError::Format("unterminated 'descr'".into()))?;
     let descr = parse_descr(&descr_txt[1..1 + end])?;
 
     let fortran = header_field(header, "fortran_order")?.starts_with("True");
 
     let shape_txt = header_field(header, "shape")?;
-    let shape_txt = shape_txt
-        .strip_prefix('(')
-        .ok_or_else(|| NpyError::Format("'shape' is not a tuple".into()))?;
-    let close = shape_txt
-        .find(')')
-        .ok_or_else(|| NpyError::Format("unterminated 'shape'".into()))?;
+    let shape_txt =
+        shape_txt.strip_prefix('(').ok_or_else(|| NpyError::Format("'shape' is not a tuple".into()))?;
+    let close = shape_txt.find(')').ok_or_else(|| NpyError::Format("unterminated 'shape'".into()))?;
     let shape = shape_txt[..close]
         .split(',')
         .map(str::trim)
@@ -308,9 +300,7 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
         .try_fold(1usize, |a, &d| a.checked_mul(d))
         .ok_or_else(|| NpyError::Format("shape overflows".into()))?;
     let elem = if descr.kind == Kind::Unicode { 4 * descr.size } else { descr.size };
-    let need = count
-        .checked_mul(elem)
-        .ok_or_else(|| NpyError::Format("shape overflows".into()))?;
+    let need = count.checked_mul(elem).ok_or_else(|| NpyError::Format("shape overflows".into()))?;
     let raw = &bytes[header_end..];
     if raw.len() < need {
         return Err(NpyError::Format(format!(
@@ -356,10 +346,7 @@ pub fn write_npy(array: &NpyArray) -> Vec<u8> {
     };
     let shape = match array.shape.len() {
         1 => format!("({},)", array.shape[0]),
-        _ => format!(
-            "({})",
-            array.shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")
-        ),
+        _ => format!("({})", array.shape.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")),
     };
     let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
     // Pad so that the data starts on a 64-byte boundary, ending the header with '\n'.
@@ -381,9 +368,8 @@ mod tests {
 
     /// Bytes that `numpy.save` writes for `np.array([[1, 2, 3], [4, 5, 6]], dtype='<f8')`.
     fn numpy_f8_2x3() -> Vec<u8> {
-        let mut header =
-            "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }".to_string();
-        while (10 + header.len() + 1) % 64 != 0 {
+        let mut header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }".to_string();
+        while !(10 + header.len() + 1).is_multiple_of(64) {
             header.push(' ');
         }
         header.push('\n');
@@ -436,9 +422,7 @@ mod tests {
     #[test]
     fn small_int_widths_sign_extend() {
         let d = parse_descr("<i2").unwrap();
-        let NpyData::I64(v) = decode(&d, &[0xff, 0xff, 0x02, 0x00], 2).unwrap() else {
-            panic!()
-        };
+        let NpyData::I64(v) = decode(&d, &[0xff, 0xff, 0x02, 0x00], 2).unwrap() else { panic!() };
         assert_eq!(v, vec![-1, 2]);
     }
 }

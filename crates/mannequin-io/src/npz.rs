@@ -75,12 +75,16 @@ impl Npz {
 
     /// The array under `key` as f64, checking its shape against `expected`
     /// (`None` entries match any size).
-    pub fn f64_with_shape(&self, key: &str, expected: &[Option<usize>]) -> Result<(Vec<usize>, Vec<f64>), IoError> {
+    pub fn f64_with_shape(
+        &self,
+        key: &str,
+        expected: &[Option<usize>],
+    ) -> Result<(Vec<usize>, Vec<f64>), IoError> {
         let a = self.require(key)?;
         check_shape(self, key, &a.shape, expected)?;
-        let v = a
-            .to_f64()
-            .ok_or_else(|| self.field_error(key, format!("expected numbers, found dtype {}", a.dtype_name())))?;
+        let v = a.to_f64().ok_or_else(|| {
+            self.field_error(key, format!("expected numbers, found dtype {}", a.dtype_name()))
+        })?;
         Ok((a.shape.clone(), v))
     }
 }
@@ -91,7 +95,8 @@ fn shape_text(expected: &[Option<usize>]) -> String {
 }
 
 fn check_shape(npz: &Npz, key: &str, shape: &[usize], expected: &[Option<usize>]) -> Result<(), IoError> {
-    let ok = shape.len() == expected.len() && shape.iter().zip(expected).all(|(s, e)| e.is_none_or(|e| e == *s));
+    let ok =
+        shape.len() == expected.len() && shape.iter().zip(expected).all(|(s, e)| e.is_none_or(|e| e == *s));
     if ok {
         Ok(())
     } else {
@@ -131,7 +136,8 @@ impl NpzWriter {
 
     pub fn write(&self, path: impl AsRef<Path>) -> Result<(), IoError> {
         let path = path.as_ref();
-        write_atomic(path, &self.to_bytes()).map_err(|source| IoError::Io { path: path.to_path_buf(), source })
+        write_atomic(path, &self.to_bytes())
+            .map_err(|source| IoError::Io { path: path.to_path_buf(), source })
     }
 }
 

@@ -1,7 +1,11 @@
 //! `mannequin <verb>`: the one binary. Each verb lives in its own module with its clap
 //! arguments and a `run` function; this file only dispatches and reports errors.
 
+mod animate;
+mod body;
+mod demo;
 mod eval;
+mod motion;
 mod progress;
 mod synth;
 
@@ -19,6 +23,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Inspect or pose a body model (SMPL, SMPL-H, SMPL-X or the embedded default).
+    #[command(subcommand)]
+    Body(body::BodyCommand),
+    /// Write motion files (a procedural walk as AMASS .npz).
+    #[command(subcommand)]
+    Motion(motion::MotionCommand),
+    /// Drive a body with an AMASS or PeopleSnapshot motion and write a skinned, animated .glb.
+    Animate(animate::Args),
+    /// The main job on the embedded default body: pose, animate and export, under one folder.
+    Demo(demo::Args),
     /// Compare predictions with a ground-truth dataset: PSNR, SSIM, LPIPS, normal and geometry errors.
     Eval(eval::Args),
     /// Generate a synthetic clothed subject with full ground truth, in the dataset layout.
@@ -29,6 +43,10 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     progress::init_logging(cli.verbose);
     let result: anyhow::Result<()> = match cli.command {
+        Command::Body(cmd) => body::run(cmd),
+        Command::Motion(cmd) => motion::run(cmd),
+        Command::Animate(args) => animate::run(args),
+        Command::Demo(args) => demo::run(args),
         Command::Eval(args) => eval::run(args),
         Command::Synth(args) => synth::run(args),
     };

@@ -5,7 +5,8 @@ use std::f64::consts::PI;
 
 use mannequin_io::{NpyArray, NpzWriter};
 
-const SMPL_PARENTS: [i64; 24] = [-1, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 9, 9, 12, 13, 14, 16, 17, 18, 19, 20, 21];
+const SMPL_PARENTS: [i64; 24] =
+    [-1, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 9, 9, 12, 13, 14, 16, 17, 18, 19, 20, 21];
 
 fn splitmix64(x: u64) -> u64 {
     let mut z = x.wrapping_add(0x9E3779B97F4A7C15);
@@ -24,7 +25,9 @@ pub fn grid(rings: usize, segments: usize) -> (Vec<f32>, Vec<i64>) {
         let phi = (r as f64 + 0.5) / rings as f64 * PI;
         for s in 0..segments {
             let lam = s as f64 / segments as f64 * 2.0 * PI;
-            v.extend([0.3 * phi.sin() * lam.cos(), 0.9 * phi.cos(), 0.2 * phi.sin() * lam.sin()].map(|x| x as f32));
+            v.extend(
+                [0.3 * phi.sin() * lam.cos(), 0.9 * phi.cos(), 0.2 * phi.sin() * lam.sin()].map(|x| x as f32),
+            );
         }
     }
     let mut f = Vec::new();
@@ -42,7 +45,8 @@ pub fn grid(rings: usize, segments: usize) -> (Vec<f32>, Vec<i64>) {
 pub fn random_model_npz(joints: usize, components: usize, rings: usize, segments: usize) -> Vec<u8> {
     let (v_template, faces) = grid(rings, segments);
     let nv = v_template.len() / 3;
-    let scaled = |stream, n| uniform(stream, n).into_iter().map(|u| (0.02 * (u - 0.5)) as f32).collect::<Vec<_>>();
+    let scaled =
+        |stream, n| uniform(stream, n).into_iter().map(|u| (0.02 * (u - 0.5)) as f32).collect::<Vec<_>>();
     let shapedirs = scaled(1, nv * 3 * components);
     let posedirs = scaled(2, nv * 3 * 9 * (joints - 1));
     let normalise = |rows: usize, cols: usize, per: usize, pick: u64, value: u64| {
