@@ -7,6 +7,7 @@ mod demo;
 mod eval;
 mod motion;
 mod progress;
+mod splat;
 mod synth;
 
 use clap::{Parser, Subcommand};
@@ -37,6 +38,8 @@ enum Command {
     Eval(eval::Args),
     /// Generate a synthetic clothed subject with full ground truth, in the dataset layout.
     Synth(synth::Args),
+    /// Render a 3D Gaussian splatting .ply through a camera, or summarise one.
+    Splat(splat::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -49,6 +52,7 @@ fn main() -> std::process::ExitCode {
         Command::Demo(args) => demo::run(args),
         Command::Eval(args) => eval::run(args),
         Command::Synth(args) => synth::run(args),
+        Command::Splat(args) => splat::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
