@@ -1,0 +1,96 @@
+//! The command line as a user runs it: the demo on the embedded body, and one-line errors on bad
+//! files (exit code 1, no panic).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn mannequin(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mq-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn demo_writes_meshes_motion_and_glb() {
+    let out = temp("demo");
+    let o = mannequin(&["demo", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["walk.npz", "walk.glb", "poses/squat.obj", "poses/arms-raised.obj"] {
+        assert!(out.join(f).metadata().is_ok_and(|m| m.len() > 1000), "{f} missing");
+    }
+    let glb = std::fs::read(out.join("walk.glb")).unwrap();
+    assert_eq!(&glb[..4], b"glTF");
+    // The walk written by the demo animates through the animate verb too, resampled.
+    let again = out.join("again.glb");
+    let walk = out.join("walk.npz");
+    let o = mannequin(&[
+        "animate",
+        "--model",
+        "default-lod1",
+        "--motion",
+        walk.to_str().unwrap(),
+        "--fps",
+        "15",
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+#[test]
+fn body_pose_writes_obj_and_ply() {
+    let dir = temp("pose");
+    for ext in ["obj", "ply"] {
+        let path = dir.join(format!("squat.{ext}"));
+        let o = mannequin(&[
+            "body",
+            "pose",
+            "--model",
+            "default-lod1",
+            "--betas",
+            "1,-0.5",
+            "--named",
+            "squat",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(path.exists());
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+fn one_line_error(o: &Output, needles: &[&str]) {
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let line =
+        err.lines().find(|l| l.starts_with("error:")).unwrap_or_else(|| panic!("no error line in {err}"));
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(line.contains(n), "'{n}' not in: {line}");
+    }
+}
+
+#[test]
+fn bad_files_give_one_line_errors() {
+    let dir = temp("bad");
+    let model = dir.join("broken_model.npz");
+    std::fs::write(&model, b"PK\x03\x04 not really a zip").unwrap();
+    let out = dir.join("x.obj");
+    one_line_error(&mannequin(&["body", "info", model.to_str().unwrap()]), &["broken_model.npz"]);
+    let motion = dir.join("missing.npz");
+    one_line_error(
+        &mannequin(&["animate", "--motion", motion.to_str().unwrap(), "-o", out.to_str().unwrap()]),
+        &["missing.npz"],
+    );
+    one_line_error(
+        &mannequin(&["body", "pose", "--named", "cartwheel", "-o", out.to_str().unwrap()]),
+        &["cartwheel"],
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
