@@ -11,6 +11,7 @@ pub mod motion;
 pub mod named_pose;
 pub mod rodrigues;
 pub mod skinned_export;
+pub mod smpl_joint;
 pub mod smpl_npz;
 pub mod walk_cycle;
 

@@ -6,22 +6,6 @@ use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
 
 use crate::error::BodyError;
 
-/// SMPL joint indices used below.
-mod joint {
-    pub const L_HIP: usize = 1;
-    pub const R_HIP: usize = 2;
-    pub const L_KNEE: usize = 4;
-    pub const R_KNEE: usize = 5;
-    pub const L_ANKLE: usize = 7;
-    pub const R_ANKLE: usize = 8;
-    pub const L_COLLAR: usize = 13;
-    pub const R_COLLAR: usize = 14;
-    pub const L_SHOULDER: usize = 16;
-    pub const R_SHOULDER: usize = 17;
-    pub const L_ELBOW: usize = 18;
-    pub const R_ELBOW: usize = 19;
-}
-
 /// Names accepted by [`named_pose`].
 pub const POSE_NAMES: [&str; 6] = ["t-pose", "a-pose", "arms-raised", "squat", "walk", "arms-crossed"];
 
@@ -31,7 +15,7 @@ fn set(pose: &mut [f32; 72], j: usize, r: [f32; 3]) {
 
 /// The 72-value SMPL pose called `name` (see [`POSE_NAMES`]).
 pub fn named_pose(name: &str) -> Result<[f32; 72], BodyError> {
-    use joint::*;
+    use crate::smpl_joint::*;
     let mut p = [0.0f32; 72];
     match name {
         "t-pose" => {}

@@ -11,29 +11,8 @@ use glam::Vec3;
 use super::subject::Outfit;
 use crate::rng::SplitMix64;
 
-/// SMPL joint indices.
-mod joint {
-    pub const PELVIS: usize = 0;
-    pub const L_HIP: usize = 1;
-    pub const R_HIP: usize = 2;
-    pub const SPINE1: usize = 3;
-    pub const L_KNEE: usize = 4;
-    pub const R_KNEE: usize = 5;
-    pub const SPINE2: usize = 6;
-    pub const L_ANKLE: usize = 7;
-    pub const R_ANKLE: usize = 8;
-    pub const SPINE3: usize = 9;
-    pub const L_FOOT: usize = 10;
-    pub const R_FOOT: usize = 11;
-    pub const HEAD: usize = 15;
-    pub const L_COLLAR: usize = 13;
-    pub const R_COLLAR: usize = 14;
-    pub const L_SHOULDER: usize = 16;
-    pub const R_SHOULDER: usize = 17;
-    pub const L_ELBOW: usize = 18;
-    pub const R_ELBOW: usize = 19;
-}
 pub use joint::{HEAD, L_ANKLE, L_FOOT, L_HIP, L_KNEE, PELVIS, R_ANKLE, R_FOOT, R_HIP, R_KNEE};
+use mannequin_body::smpl_joint as joint;
 
 /// One garment's coverage of the joint regions and its geometry.
 #[derive(Debug, Clone)]
