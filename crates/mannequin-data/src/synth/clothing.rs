@@ -11,7 +11,6 @@ use glam::Vec3;
 use super::subject::Outfit;
 use crate::rng::SplitMix64;
 
-pub use joint::{HEAD, L_ANKLE, L_FOOT, L_HIP, L_KNEE, PELVIS, R_ANKLE, R_FOOT, R_HIP, R_KNEE};
 use mannequin_body::smpl_joint as joint;
 
 /// One garment's coverage of the joint regions and its geometry.

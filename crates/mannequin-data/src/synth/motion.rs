@@ -3,12 +3,14 @@
 
 use std::f32::consts::TAU;
 
+use mannequin_body::smpl_joint::*;
 use mannequin_body::{BodyError, Motion, named_pose};
 
 use crate::rng::SplitMix64;
 
 /// SMPL joints that sway a little while the subject holds the A-pose.
-const SWAY_JOINTS: [usize; 9] = [3, 6, 9, 12, 15, 16, 17, 18, 19];
+const SWAY_JOINTS: [usize; 9] =
+    [SPINE1, SPINE2, SPINE3, NECK, HEAD, L_SHOULDER, R_SHOULDER, L_ELBOW, R_ELBOW];
 
 /// `frames` poses (72 each) turning `turns` times about the vertical axis, starting facing
 /// the camera (+Z), with per-joint sinusoidal sway of a few degrees.

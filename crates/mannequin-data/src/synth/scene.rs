@@ -18,6 +18,7 @@ use crate::image::{Image, Mask};
 use crate::maps::{DepthMap, NormalMap};
 use crate::mesh_raster::{RasterMesh, Shading, rasterize};
 use crate::rng::SplitMix64;
+use mannequin_body::smpl_joint as joint;
 
 /// Texture sizes: the body's UV atlas and the skirt's strip beside it.
 const BODY_TEXTURE: usize = 1024;
@@ -127,15 +128,15 @@ impl Scene {
         let clothed_rest = clothing::clothe(&rest, &normals, &garments);
 
         // Hair on the top and back of the head, shoes on the feet.
-        let head = shaped.joints[clothing::HEAD];
+        let head = shaped.joints[joint::HEAD];
         let points: Vec<SurfacePoint> = (0..rest.len())
             .map(|v| {
                 let w = &weights[v * joints..(v + 1) * joints];
                 let p = Vec3::from(rest[v]);
-                let on_head = w.get(clothing::HEAD).copied().unwrap_or(0.0);
+                let on_head = w.get(joint::HEAD).copied().unwrap_or(0.0);
                 let scalp = smoothstep(0.02, 0.06, p.y - head.y)
                     .max(smoothstep(0.0, 0.04, head.z - p.z) * smoothstep(-0.06, 0.0, p.y - head.y));
-                let feet: f32 = [clothing::L_ANKLE, clothing::R_ANKLE, clothing::L_FOOT, clothing::R_FOOT]
+                let feet: f32 = [joint::L_ANKLE, joint::R_ANKLE, joint::L_FOOT, joint::R_FOOT]
                     .iter()
                     .map(|&j| w.get(j).copied().unwrap_or(0.0))
                     .sum();
@@ -145,24 +146,18 @@ impl Scene {
 
         let skirt = match subject.outfit {
             Outfit::ShirtSkirt | Outfit::Dress => {
-                let legs = [
-                    clothing::PELVIS,
-                    clothing::L_HIP,
-                    clothing::R_HIP,
-                    clothing::L_KNEE,
-                    clothing::R_KNEE,
-                    3,
-                ];
+                let legs =
+                    [joint::PELVIS, joint::L_HIP, joint::R_HIP, joint::L_KNEE, joint::R_KNEE, joint::SPINE1];
                 let inside: Vec<Vec3> = clothed_rest
                     .iter()
                     .enumerate()
                     .filter(|(v, _)| legs.contains(&dominant_joint(&weights[v * joints..(v + 1) * joints])))
                     .map(|(_, p)| Vec3::from(*p))
                     .collect();
-                let knee = shaped.joints[clothing::L_KNEE].y.min(shaped.joints[clothing::R_KNEE].y);
-                let waist = shaped.joints[3].y;
+                let knee = shaped.joints[joint::L_KNEE].y.min(shaped.joints[joint::R_KNEE].y);
+                let waist = shaped.joints[joint::SPINE1].y;
                 let hem = if subject.outfit == Outfit::Dress { knee - 0.1 } else { knee + 0.12 };
-                Some(build_skirt(&inside, shaped.joints[clothing::PELVIS], waist, hem, 0.012, 0.35))
+                Some(build_skirt(&inside, shaped.joints[joint::PELVIS], waist, hem, 0.012, 0.35))
             }
             _ => None,
         };

@@ -4,7 +4,8 @@
 
 use glam::Vec3;
 
-use super::clothing::{L_HIP, PELVIS, R_HIP, smoothstep};
+use super::clothing::smoothstep;
+use mannequin_body::smpl_joint::{L_HIP, PELVIS, R_HIP};
 use mannequin_mesh::UvLayout;
 
 pub const SEGMENTS: usize = 64;
