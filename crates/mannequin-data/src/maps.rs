@@ -162,6 +162,9 @@ pub fn read_mask_npy(path: &Path) -> Result<Mask, DataError> {
 
 /// Writes a mask as a `(H, W)` array of 0/1 (NumPy `bool`, one byte per pixel).
 pub fn write_mask_npy(path: &Path, mask: &Mask) -> Result<(), DataError> {
-    let a = NpyArray { shape: vec![mask.height, mask.width], data: NpyData::Bool(mask.values.clone()) };
+    let a = NpyArray {
+        shape: vec![mask.height, mask.width],
+        data: NpyData::U8(mask.values.iter().map(|&m| m as u8).collect()),
+    };
     mannequin_io::write_atomic(path, &mannequin_io::npy::write_npy(&a)).map_err(|e| DataError::os(path, e))
 }

@@ -15,6 +15,8 @@ pub enum NpyData {
     F64(Vec<f64>),
     I64(Vec<i64>),
     U64(Vec<u64>),
+    /// `uint8`, kept narrow because masks and images are stored this way.
+    U8(Vec<u8>),
     Bool(Vec<bool>),
     Str(Vec<String>),
 }
@@ -54,6 +56,7 @@ impl NpyArray {
             NpyData::F64(v) => v.clone(),
             NpyData::I64(v) => v.iter().map(|&x| x as f64).collect(),
             NpyData::U64(v) => v.iter().map(|&x| x as f64).collect(),
+            NpyData::U8(v) => v.iter().map(|&x| x as f64).collect(),
             NpyData::Bool(v) => v.iter().map(|&x| x as u8 as f64).collect(),
             NpyData::Str(_) => return None,
         })
@@ -72,6 +75,7 @@ impl NpyArray {
         match &self.data {
             NpyData::I64(v) => Some(v.clone()),
             NpyData::U64(v) => v.iter().map(|&x| i64::try_from(x).ok()).collect(),
+            NpyData::U8(v) => Some(v.iter().map(|&x| x as i64).collect()),
             NpyData::Bool(v) => Some(v.iter().map(|&x| x as i64).collect()),
             NpyData::Str(_) => None,
             _ => self
@@ -89,6 +93,7 @@ impl NpyArray {
             NpyData::F64(_) => "float64",
             NpyData::I64(_) => "int",
             NpyData::U64(_) => "uint",
+            NpyData::U8(_) => "uint8",
             NpyData::Bool(_) => "bool",
             NpyData::Str(_) => "str",
         }
@@ -218,6 +223,7 @@ fn decode(descr: &Descr, raw: &[u8], count: usize) -> Result<NpyData, NpyError> 
                 })
                 .collect(),
         ),
+        Kind::UInt if s == 1 => NpyData::U8(words.map(|w| w[0]).collect()),
         Kind::UInt => NpyData::U64(words.map(|w| read_word(w, be)).collect()),
         Kind::Bool => NpyData::Bool(words.map(|w| w[0] != 0).collect()),
         Kind::Bytes => NpyData::Str(
@@ -315,6 +321,7 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
             NpyData::F64(v) => NpyData::F64(fortran_to_c(&v, &shape)),
             NpyData::I64(v) => NpyData::I64(fortran_to_c(&v, &shape)),
             NpyData::U64(v) => NpyData::U64(fortran_to_c(&v, &shape)),
+            NpyData::U8(v) => NpyData::U8(fortran_to_c(&v, &shape)),
             NpyData::Bool(v) => NpyData::Bool(fortran_to_c(&v, &shape)),
             NpyData::Str(v) => NpyData::Str(fortran_to_c(&v, &shape)),
         };
@@ -329,6 +336,7 @@ pub fn write_npy(array: &NpyArray) -> Vec<u8> {
         NpyData::F64(v) => ("<f8".into(), v.iter().flat_map(|x| x.to_le_bytes()).collect()),
         NpyData::I64(v) => ("<i8".into(), v.iter().flat_map(|x| x.to_le_bytes()).collect()),
         NpyData::U64(v) => ("<u8".into(), v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+        NpyData::U8(v) => ("|u1".into(), v.clone()),
         NpyData::Bool(v) => ("|b1".into(), v.iter().map(|&b| b as u8).collect()),
         NpyData::Str(v) => {
             let width = v.iter().map(|s| s.chars().count()).max().unwrap_or(0).max(1);
@@ -407,6 +415,7 @@ mod tests {
             NpyArray::i64(vec![2, 2], vec![-1, 2, -3, 4]),
             NpyArray { shape: vec![2], data: NpyData::Str(vec!["male".into(), "f".into()]) },
             NpyArray { shape: vec![], data: NpyData::F64(vec![120.0]) },
+            NpyArray { shape: vec![2, 2], data: NpyData::U8(vec![0, 1, 1, 255]) },
         ] {
             assert_eq!(parse_npy(&write_npy(&a)).unwrap(), a);
         }
