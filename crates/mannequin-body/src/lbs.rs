@@ -141,52 +141,59 @@ pub fn pose_frames(
     let len = shaped.vertices.len();
     let rotations = frame_rotations(poses);
 
-    // v_posed = v_shaped + P · features, for all frames in one GEMM.
-    let mut vertices: Vec<f32> = Vec::with_capacity(f * len);
-    for _ in 0..f {
-        vertices.extend_from_slice(&shaped.vertices);
-    }
     let p = model.num_pose_features();
-    if p > 0 {
-        let feats = pose_features(&rotations, j);
-        faer::linalg::matmul::matmul(
-            MatMut::from_row_major_slice_mut(&mut vertices, f, len),
-            Accum::Add,
-            MatRef::from_row_major_slice(&feats, f, p),
-            MatRef::from_row_major_slice(model.posedirs(), p, len),
-            1.0f32,
-            Par::rayon(0),
-        );
-    }
-
+    let feats = if p > 0 { pose_features(&rotations, j) } else { Vec::new() };
+    let mut vertices = vec![0.0f32; f * len];
     let mut joints = vec![0.0f32; f * j * 3];
     let mut transforms = vec![Affine3A::IDENTITY; f * j];
     let skin = model.skin();
+    // One group of frames per thread: the pose-corrective GEMM streams the large posedirs matrix
+    // once per group, so few big groups beat many small ones (memory-bound otherwise).
+    let group_frames = f.div_ceil(rayon::current_num_threads()).max(1);
     vertices
-        .par_chunks_mut(len)
-        .zip(joints.par_chunks_mut(3 * j))
-        .zip(transforms.par_chunks_mut(j))
+        .par_chunks_mut(group_frames * len)
+        .zip(joints.par_chunks_mut(group_frames * 3 * j))
+        .zip(transforms.par_chunks_mut(group_frames * j))
         .enumerate()
-        .for_each(|(fi, ((verts, joints_out), world_out))| {
-            let t = Vec3A::from_slice(&transl[3 * fi..3 * fi + 3]);
-            let world = world_transforms(model.parents(), &rotations[fi * j..(fi + 1) * j], &shaped.joints);
-            let skinning = skinning_transforms(&world, &shaped.joints);
-            for (v, xyz) in verts.chunks_exact_mut(3).enumerate() {
-                // Blend the 3×4 matrices of the joints that influence this vertex.
-                let mut m = Mat3A::ZERO;
-                let mut tr = Vec3A::ZERO;
-                for (k, w) in skin.row(v) {
-                    m += skinning[k].matrix3 * w;
-                    tr += skinning[k].translation * w;
-                }
-                let out = m * Vec3A::from_slice(xyz) + tr + t;
-                xyz.copy_from_slice(&out.to_array());
+        .for_each(|(g, ((group, joints_out), world_out))| {
+            let first = g * group_frames;
+            let n = group.len() / len;
+            group.chunks_exact_mut(len).for_each(|v| v.copy_from_slice(&shaped.vertices));
+            // v_posed = v_shaped + P · features, one small GEMM per group.
+            if p > 0 {
+                faer::linalg::matmul::matmul(
+                    MatMut::from_row_major_slice_mut(group, n, len),
+                    Accum::Add,
+                    MatRef::from_row_major_slice(&feats[first * p..(first + n) * p], n, p),
+                    MatRef::from_row_major_slice(model.posedirs(), p, len),
+                    1.0f32,
+                    Par::Seq,
+                );
             }
-            for (k, g) in world.iter().enumerate() {
-                let mut g = *g;
-                g.translation += t;
-                joints_out[3 * k..3 * k + 3].copy_from_slice(&g.translation.to_array());
-                world_out[k] = g;
+            for (i, verts) in group.chunks_exact_mut(len).enumerate() {
+                let fi = first + i;
+                let t = Vec3A::from_slice(&transl[3 * fi..3 * fi + 3]);
+                let world =
+                    world_transforms(model.parents(), &rotations[fi * j..(fi + 1) * j], &shaped.joints);
+                let skinning = skinning_transforms(&world, &shaped.joints);
+                for (v, xyz) in verts.chunks_exact_mut(3).enumerate() {
+                    // Blend the 3×4 matrices of the joints that influence this vertex.
+                    let mut m = Mat3A::ZERO;
+                    let mut tr = Vec3A::ZERO;
+                    for (k, w) in skin.row(v) {
+                        m += skinning[k].matrix3 * w;
+                        tr += skinning[k].translation * w;
+                    }
+                    let out = m * Vec3A::from_slice(xyz) + tr + t;
+                    xyz.copy_from_slice(&out.to_array());
+                }
+                for (k, g) in world.iter().enumerate() {
+                    let mut g = *g;
+                    g.translation += t;
+                    joints_out[3 * (i * j + k)..3 * (i * j + k) + 3]
+                        .copy_from_slice(&g.translation.to_array());
+                    world_out[i * j + k] = g;
+                }
             }
         });
     Ok(PosedFrames { num_frames: f, vertices, joints, transforms })
