@@ -17,6 +17,9 @@ use crate::project::Projection;
 use crate::real::Real;
 use crate::tiles::{CULL_SLACK, Tiles};
 
+/// How many list entries ahead to prefetch.
+pub(crate) const PREFETCH_AHEAD: usize = 2;
+
 /// Pixels in one tile.
 pub(crate) const TILE_PIXELS: usize = TILE * TILE;
 
@@ -86,6 +89,22 @@ impl<T: Real> Packed<T> {
     pub fn row(&self, i: u32) -> &[T] {
         let i = i as usize;
         &self.rows[self.stride * i..self.stride * (i + 1)]
+    }
+}
+
+/// Asks the CPU to start loading `data[at..]` into cache: tile lists jump around the packed rows
+/// and gradient buffers, and the loads would otherwise stall the lane loops.
+#[inline(always)]
+pub(crate) fn prefetch<T>(data: &[T], at: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if at < data.len() {
+        // SAFETY: a prefetch is only a hint: it cannot fault or change memory, and SSE (which
+        // provides it) is part of the x86_64 baseline. The address is inside `data`.
+        unsafe {
+            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                data.as_ptr().add(at).cast(),
+            );
+        }
     }
 }
 
@@ -204,6 +223,9 @@ pub(crate) fn composite_tile<T: Real>(
     let mut live_rows = rect.h;
     let (mut sigma, mut expo, mut w) = ([T::ZERO; TILE], [T::ZERO; TILE], [T::ZERO; TILE]);
     for (k, &gid) in list.iter().enumerate() {
+        if let Some(&ahead) = list.get(k + PREFETCH_AHEAD) {
+            prefetch(&packed.rows, ahead as usize * packed.stride);
+        }
         let g = packed.row(gid);
         let (o, z) = (g[field::OPACITY], g[field::DEPTH]);
         let entry = k as u32 + 1;

@@ -9,7 +9,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::TILE;
-use crate::composite::{Packed, Rule, TILE_PIXELS, TileRect, field, row_sigma};
+use crate::composite::{PREFETCH_AHEAD, Packed, Rule, TILE_PIXELS, TileRect, field, prefetch, row_sigma};
 use crate::real::Real;
 
 /// Gradient slots per Gaussian emitted by a tile: mean x, mean y, conic a, b, c, opacity,
@@ -53,7 +53,6 @@ pub(crate) struct Replay<T> {
     acc_depth: [T; TILE_PIXELS],
     /// Per-lane gradient sums for the current Gaussian: `SCREEN_GRADS + C` vectors of 16.
     lanes: Vec<[T; TILE]>,
-    sums: Vec<T>,
 }
 
 impl<T: Real> Replay<T> {
@@ -63,13 +62,12 @@ impl<T: Real> Replay<T> {
             acc_color: vec![T::ZERO; channels * TILE_PIXELS],
             acc_depth: [T::ZERO; TILE_PIXELS],
             lanes: vec![[T::ZERO; TILE]; SCREEN_GRADS + channels],
-            sums: vec![T::ZERO; SCREEN_GRADS + channels],
         }
     }
 }
 
-/// Replays tile `rect` and calls `emit(rank, grads)` with the screen-space gradients of each
-/// Gaussian (by depth rank) that reached a pixel (`SCREEN_GRADS + C` values).
+/// Replays tile `rect` and adds the screen-space gradients of each Gaussian that reached a pixel
+/// (`SCREEN_GRADS + C` values) into row `rank` of `acc`.
 pub(crate) fn composite_tile_vjp<T: Real>(
     rect: TileRect,
     list: &[u32],
@@ -77,7 +75,7 @@ pub(crate) fn composite_tile_vjp<T: Real>(
     rule: &Rule<T>,
     px: &TileGrads<T>,
     st: &mut Replay<T>,
-    mut emit: impl FnMut(u32, &[T]),
+    acc: &mut [T],
 ) {
     let channels = packed.stride - field::COLOR;
     st.t.fill(T::ONE);
@@ -94,7 +92,12 @@ pub(crate) fn composite_tile_vjp<T: Real>(
         ([T::ZERO; TILE], [T::ZERO; TILE], [T::ZERO; TILE], [T::ZERO; TILE]);
     let mut alpha = [T::ZERO; TILE];
     let mut take = [false; TILE];
+    let stride = SCREEN_GRADS + channels;
     for (k, &gid) in list[..end].iter().enumerate() {
+        if let Some(&ahead) = list[..end].get(k + PREFETCH_AHEAD) {
+            prefetch(&packed.rows, ahead as usize * packed.stride);
+            prefetch(acc, ahead as usize * stride);
+        }
         let g = packed.row(gid);
         let (o, z) = (g[field::OPACITY], g[field::DEPTH]);
         let (mx, a, b, c) = (g[field::MX], g[field::A], g[field::B], g[field::C]);
@@ -164,10 +167,10 @@ pub(crate) fn composite_tile_vjp<T: Real>(
             }
         }
         if touched {
-            for (s, lane) in st.sums.iter_mut().zip(&st.lanes) {
-                *s = lane.iter().copied().sum();
+            let row = &mut acc[gid as usize * stride..(gid as usize + 1) * stride];
+            for (s, lane) in row.iter_mut().zip(&st.lanes) {
+                *s += lane.iter().copied().sum();
             }
-            emit(gid, &st.sums);
         }
     }
 }

@@ -25,6 +25,7 @@ mod composite;
 mod composite_vjp;
 mod error;
 mod gaussians;
+mod planes;
 pub mod ply;
 mod project;
 mod real;

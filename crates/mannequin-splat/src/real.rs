@@ -140,24 +140,29 @@ fn total_order_bits_f32(v: f32) -> u32 {
 }
 
 /// `exp(x)` for `f32` by range reduction `x = n ln 2 + r` and a degree-6 polynomial on
-/// `|r| ≤ ln 2 / 2` (the Cephes `expf` coefficients, about 1 ulp). Branch-free, so a loop over
-/// lanes compiles to vector code.
+/// `|r| ≤ ln 2 / 2` (the Cephes `expf` coefficients, about 1 ulp). Branch-free and free of
+/// float→int casts (Rust's saturating `as` does not vectorise), so a loop over lanes compiles
+/// to vector code: `n` is rounded, and its bits extracted, by adding 1.5·2²³.
 #[inline(always)]
 fn exp_f32(x: f32) -> f32 {
     const LOG2E: f32 = std::f32::consts::LOG2_E;
     const LN2_HI: f32 = 0.693_359_4;
     const LN2_LO: f32 = -2.121_944_4e-4;
+    const SHIFTER: f32 = 12_582_912.0;
     let x = x.clamp(-60.0, 80.0);
-    let n = (x * LOG2E).round_ties_even();
+    let shifted = x * LOG2E + SHIFTER;
+    let n = shifted - SHIFTER;
     let r = x - n * LN2_HI - n * LN2_LO;
-    let mut p = 1.987_569_1e-4_f32;
-    p = p * r + 1.398_199_9e-3;
-    p = p * r + 8.333_452e-3;
-    p = p * r + 4.166_579_6e-2;
-    p = p * r + 1.666_666_5e-1;
-    p = p * r + 0.5;
-    let y = p * r * r + r + 1.0;
-    y * f32::from_bits(((n as i32 + 127) as u32) << 23)
+    // The Cephes polynomial in Estrin's scheme (a shorter dependency chain than Horner's).
+    let r2 = r * r;
+    let p01 = 0.5 + 1.666_666_5e-1 * r;
+    let p23 = 4.166_579_6e-2 + 8.333_452e-3 * r;
+    let p45 = 1.398_199_9e-3 + 1.987_569_1e-4 * r;
+    let p = p01 + r2 * (p23 + r2 * p45);
+    let y = p * r2 + r + 1.0;
+    // The low mantissa bits of `shifted` hold n; move n + 127 into the exponent field.
+    let n_bits = shifted.to_bits().wrapping_sub(SHIFTER.to_bits());
+    y * f32::from_bits(n_bits.wrapping_add(127) << 23)
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@ use crate::camera::{Camera, CameraParams};
 use crate::composite::{Packed, Rule, TILE_PIXELS, TileOut, TileRect, composite_tile, field};
 use crate::composite_vjp::{Replay, SCREEN_GRADS, TileGrads, composite_tile_vjp};
 use crate::gaussians::{GaussianGrads, Gaussians};
+use crate::planes::TilePlanes;
 use crate::project::{GradRow, ScreenGrad, project, project_vjp};
 use crate::real::Real;
 use crate::tiles::{Tiles, bin};
@@ -161,27 +162,6 @@ pub fn project_gaussians<T: Real>(
     Ok(project(g, &CameraParams::new(camera), opts.alpha_threshold))
 }
 
-/// Rearranges tile-major data (`planes` planes of 256 values per tile) into planar row-major
-/// images of `w × h`.
-fn untile<U: Copy + Default + Send + Sync>(
-    src: &[U],
-    planes: usize,
-    w: usize,
-    h: usize,
-    tiles_x: usize,
-) -> Vec<U> {
-    let mut dst = vec![U::default(); planes * w * h];
-    dst.par_chunks_mut(w).enumerate().for_each(|(row, out)| {
-        let (plane, y) = (row / h, row % h);
-        let (ty, r) = (y / TILE, y % TILE);
-        for (tx, seg) in out.chunks_mut(TILE).enumerate() {
-            let base = ((ty * tiles_x + tx) * planes + plane) * TILE_PIXELS + r * TILE;
-            seg.copy_from_slice(&src[base..base + seg.len()]);
-        }
-    });
-    dst
-}
-
 /// Renders the Gaussians through the camera.
 pub fn render<T: Real>(
     g: &Gaussians<T>,
@@ -191,48 +171,51 @@ pub fn render<T: Real>(
     let (prep, skipped) = prepare(g, camera, opts)?;
     let (w, h, ch) = (camera.width, camera.height, g.channels());
     let tiles = &prep.tiles;
-    let n_tiles = tiles.tiles_x * tiles.tiles_y;
     let rule = opts.rule::<T>();
-    // Tile-major results, filled in parallel, then rearranged into planar images.
-    let mut t_color = vec![T::ZERO; n_tiles * ch * TILE_PIXELS];
-    let mut t_trans = vec![T::ONE; n_tiles * TILE_PIXELS];
-    let mut t_depth = vec![T::ZERO; n_tiles * TILE_PIXELS];
-    let mut t_last = vec![0u32; n_tiles * TILE_PIXELS];
-    let mut t_count = vec![0u32; n_tiles * TILE_PIXELS];
-    t_color
-        .par_chunks_mut(ch * TILE_PIXELS)
-        .zip(t_trans.par_chunks_mut(TILE_PIXELS))
-        .zip(t_depth.par_chunks_mut(TILE_PIXELS))
-        .zip(t_last.par_chunks_mut(TILE_PIXELS))
-        .zip(t_count.par_chunks_mut(TILE_PIXELS))
-        .enumerate()
-        .for_each_init(
+    let npx = w * h;
+    let mut image = vec![T::ZERO; ch * npx];
+    let mut transmittance = vec![T::ONE; npx];
+    let mut depth = vec![T::ZERO; npx];
+    let mut last = vec![0u32; npx];
+    let mut count = vec![0u32; if opts.count_contributors { npx } else { 0 }];
+    {
+        let planes = (
+            TilePlanes::new(&mut image, w, h),
+            TilePlanes::new(&mut transmittance, w, h),
+            TilePlanes::new(&mut depth, w, h),
+            TilePlanes::new(&mut last, w, h),
+            TilePlanes::new(&mut count, w, h),
+        );
+        (0..tiles.tiles_x * tiles.tiles_y).into_par_iter().for_each_init(
             || TileOut::new(ch),
-            |out, (tile, ((((col, tr), dep), last), count))| {
+            |out, tile| {
                 let rect = TileRect::new(tiles, tile, w, h);
                 composite_tile(rect, tiles.list(tile), &prep.packed, &rule, out);
-                col.copy_from_slice(&out.color);
-                tr.copy_from_slice(&out.transmittance);
-                dep.copy_from_slice(&out.depth);
-                last.copy_from_slice(&out.last);
-                count.copy_from_slice(&out.count);
+                // SAFETY: every tile index is visited once, and tiles are disjoint.
+                unsafe {
+                    for c in 0..ch {
+                        planes.0.write(&rect, c, &out.color[c * TILE_PIXELS..(c + 1) * TILE_PIXELS]);
+                    }
+                    planes.1.write(&rect, 0, &out.transmittance);
+                    planes.2.write(&rect, 0, &out.depth);
+                    planes.3.write(&rect, 0, &out.last);
+                    if opts.count_contributors {
+                        planes.4.write(&rect, 0, &out.count);
+                    }
+                }
             },
         );
-    let tx = tiles.tiles_x;
-    let transmittance = untile(&t_trans, 1, w, h, tx);
+    }
     let bg = opts.background_of::<T>(ch);
-    let mut image = untile(&t_color, ch, w, h, tx);
-    image.par_chunks_mut(w * h).zip(bg.par_iter()).for_each(|(plane, &b)| {
+    image.par_chunks_mut(npx).zip(bg.par_iter()).for_each(|(plane, &b)| {
         for (v, &t) in plane.iter_mut().zip(&transmittance) {
             *v += t * b;
         }
     });
     let alpha: Vec<T> = transmittance.par_iter().map(|&t| T::ONE - t).collect();
     let min_a = T::from_f64(MIN_ALPHA_FOR_DEPTH);
-    let mut depth = untile(&t_depth, 1, w, h, tx);
     depth.par_iter_mut().zip(&alpha).for_each(|(d, &a)| *d = *d / a.max(min_a));
-    let last = untile(&t_last, 1, w, h, tx);
-    let count = opts.count_contributors.then(|| untile(&t_count, 1, w, h, tx));
+    let count = opts.count_contributors.then_some(count);
     Ok(RenderOutput {
         width: w,
         height: h,
@@ -345,12 +328,7 @@ pub fn backward<T: Real>(
             }
             let slot = rayon::current_thread_index().unwrap_or(0) % workers;
             let mut buf = bufs[slot].lock().unwrap_or_else(|e| e.into_inner());
-            composite_tile_vjp(rect, list, &prep.packed, &rule, px, replay, |rank, v| {
-                let row = &mut buf[rank as usize * stride..(rank as usize + 1) * stride];
-                for (dst, s) in row.iter_mut().zip(v) {
-                    *dst += *s;
-                }
-            });
+            composite_tile_vjp(rect, list, &prep.packed, &rule, px, replay, &mut buf);
         },
     );
     let bufs: Vec<Vec<T>> =
