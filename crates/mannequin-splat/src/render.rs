@@ -133,15 +133,30 @@ pub(crate) struct Prepared<T> {
     pub tiles: Tiles,
 }
 
+/// Checks the camera, options and array shapes, and with `values` also each Gaussian's domain.
+/// The tensor path skips the per-value check (it would cost a device read-back); there a
+/// Gaussian outside its domain is rendered by the same formulas, never panicking.
+pub(crate) fn validate<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    values: bool,
+) -> Result<(), SplatError> {
+    camera.validate()?;
+    g.validate_shapes()?;
+    if values {
+        g.validate_values()?;
+    }
+    opts.validate(g.channels())
+}
+
 fn prepare<T: Real>(
     g: &Gaussians<T>,
     camera: &Camera,
     opts: &RenderOptions,
+    values: bool,
 ) -> Result<(Prepared<T>, usize), SplatError> {
-    camera.validate()?;
-    g.validate_shapes()?;
-    g.validate_values()?;
-    opts.validate(g.channels())?;
+    validate(g, camera, opts, values)?;
     let projection = project(g, &CameraParams::new(camera), opts.alpha_threshold);
     let tiles = bin(&projection, g.opacities, opts.alpha_threshold, camera.width, camera.height);
     let packed = Packed::new(&projection, g.opacities, g.channels(), opts.alpha_threshold, &tiles.order);
@@ -155,10 +170,7 @@ pub fn project_gaussians<T: Real>(
     camera: &Camera,
     opts: &RenderOptions,
 ) -> Result<crate::Projection<T>, SplatError> {
-    camera.validate()?;
-    g.validate_shapes()?;
-    g.validate_values()?;
-    opts.validate(g.channels())?;
+    validate(g, camera, opts, true)?;
     Ok(project(g, &CameraParams::new(camera), opts.alpha_threshold))
 }
 
@@ -168,7 +180,17 @@ pub fn render<T: Real>(
     camera: &Camera,
     opts: &RenderOptions,
 ) -> Result<RenderOutput<T>, SplatError> {
-    let (prep, skipped) = prepare(g, camera, opts)?;
+    render_checked(g, camera, opts, true)
+}
+
+/// [`render`], checking per-Gaussian domains only if `values`.
+pub(crate) fn render_checked<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    values: bool,
+) -> Result<RenderOutput<T>, SplatError> {
+    let (prep, skipped) = prepare(g, camera, opts, values)?;
     let (w, h, ch) = (camera.width, camera.height, g.channels());
     let tiles = &prep.tiles;
     let rule = opts.rule::<T>();
@@ -239,10 +261,19 @@ pub fn backward<T: Real>(
     out: &RenderOutput<T>,
     grads: &OutputGrads<T>,
 ) -> Result<GaussianGrads<T>, SplatError> {
-    camera.validate()?;
-    g.validate_shapes()?;
-    g.validate_values()?;
-    opts.validate(g.channels())?;
+    backward_checked(g, camera, opts, out, grads, true)
+}
+
+/// [`backward`], checking per-Gaussian domains only if `values`.
+pub(crate) fn backward_checked<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    out: &RenderOutput<T>,
+    grads: &OutputGrads<T>,
+    values: bool,
+) -> Result<GaussianGrads<T>, SplatError> {
+    validate(g, camera, opts, values)?;
     let prep = &out.saved.prep;
     let (w, h, ch) = (camera.width, camera.height, g.channels());
     let npx = w * h;

@@ -1,0 +1,82 @@
+//! The forward pass's state for the backward pass (packed Gaussians, tile lists, per-pixel
+//! replay lengths), flattened into one `f32` tensor so that Burn can keep it between the passes.
+//! Integers travel as their bit patterns, so nothing is rounded.
+
+use crate::composite::Packed;
+use crate::render::{Prepared, RenderOutput, Saved};
+use crate::tiles::Tiles;
+
+const HEADER: usize = 8;
+
+fn bits(v: usize) -> f32 {
+    f32::from_bits(v as u32)
+}
+
+fn int(v: f32) -> usize {
+    v.to_bits() as usize
+}
+
+/// Flattens what [`crate::backward`] needs besides the images.
+pub(crate) fn encode(out: &RenderOutput<f32>) -> Vec<f32> {
+    let Saved { prep: Prepared { packed, tiles }, last } = &out.saved;
+    let header = [
+        packed.stride,
+        tiles.tiles_x,
+        tiles.tiles_y,
+        tiles.order.len(),
+        tiles.offsets.len(),
+        tiles.ids.len(),
+        last.len(),
+        packed.rows.len(),
+    ];
+    let mut w = Vec::with_capacity(HEADER + header[3..].iter().sum::<usize>());
+    w.extend(header.map(bits));
+    w.extend(tiles.order.iter().map(|&v| bits(v as usize)));
+    w.extend(tiles.offsets.iter().map(|&v| bits(v)));
+    w.extend(tiles.ids.iter().map(|&v| bits(v as usize)));
+    w.extend(last.iter().map(|&v| bits(v as usize)));
+    w.extend_from_slice(&packed.rows);
+    w
+}
+
+/// Rebuilds a forward output from its images (`[C + 2, H, W]`: colour, alpha, depth) and the
+/// words [`encode`] wrote. Returns `None` if the words are not such a state.
+pub(crate) fn decode(
+    rendered: &[f32],
+    words: &[f32],
+    width: usize,
+    height: usize,
+) -> Option<RenderOutput<f32>> {
+    let npx = width * height;
+    let channels = (rendered.len() / npx.max(1)).checked_sub(2)?;
+    let header: Vec<usize> = words.get(..HEADER)?.iter().map(|&v| int(v)).collect();
+    let [stride, tiles_x, tiles_y, n_order, n_offsets, n_ids, n_last, n_rows] = header[..] else {
+        return None;
+    };
+    let mut at = HEADER;
+    let mut take = |n: usize| -> Option<&[f32]> {
+        let s = words.get(at..at + n)?;
+        at += n;
+        Some(s)
+    };
+    let order = take(n_order)?.iter().map(|&v| int(v) as u32).collect();
+    let offsets = take(n_offsets)?.iter().map(|&v| int(v)).collect();
+    let ids = take(n_ids)?.iter().map(|&v| int(v) as u32).collect();
+    let last: Vec<u32> = take(n_last)?.iter().map(|&v| int(v) as u32).collect();
+    let rows = take(n_rows)?.to_vec();
+    if last.len() != npx || rendered.len() != (channels + 2) * npx {
+        return None;
+    }
+    let tiles = Tiles { tiles_x, tiles_y, order, offsets, ids };
+    Some(RenderOutput {
+        width,
+        height,
+        channels,
+        image: rendered[..channels * npx].to_vec(),
+        alpha: rendered[channels * npx..(channels + 1) * npx].to_vec(),
+        depth: rendered[(channels + 1) * npx..].to_vec(),
+        count: None,
+        skipped: 0,
+        saved: Saved { prep: Prepared { packed: Packed { stride, rows }, tiles }, last },
+    })
+}
