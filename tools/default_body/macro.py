@@ -96,7 +96,9 @@ def sample_population(n, seed):
     is gender-neutral. Age is mostly adult (18-40 years), with some older adults (40-75) and a
     few older teenagers (16-18). Muscle, weight and proportions are Beta distributions around MakeHuman's
     average 0.5. MakeHuman's height slider spans about 1.1 m to 2.4 m, so height is a narrow
-    normal around 0.5 (about 7 cm of standard deviation on its own; gender and age add the rest).
+    normal (about 7 cm of standard deviation on its own; gender and age add the rest). Its mean
+    0.54 rather than 0.5 because MakeHuman's 0.5 makes adults of 1.60 m (female) and 1.69 m
+    (male), a few centimetres below typical adult averages.
     """
     rng = np.random.default_rng(seed)
     gender = rng.beta(0.7, 0.7, n)
@@ -109,6 +111,6 @@ def sample_population(n, seed):
         "age": age_value(years),
         "muscle": rng.beta(3, 3, n),
         "weight": rng.beta(2.5, 2.5, n),
-        "height": np.clip(rng.normal(0.5, 0.055, n), 0.25, 0.75),
+        "height": np.clip(rng.normal(0.54, 0.055, n), 0.25, 0.8),
         "proportions": rng.beta(2, 2, n),
     }

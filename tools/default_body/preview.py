@@ -53,7 +53,7 @@ def draw(ax, v, f, joints, parents, view):
         xy, depth, light = v[:, [0, 1]], v[:, 2], np.array([0.3, 0.4, 1.0])
         jxy = joints[:, [0, 1]]
     else:
-        xy, depth, light = v[:, [2, 1]] * np.array([-1, 1]), -v[:, 0], np.array([-1.0, 0.4, 0.3])
+        xy, depth, light = v[:, [2, 1]] * np.array([-1, 1]), v[:, 0], np.array([1.0, 0.4, 0.3])
         jxy = joints[:, [2, 1]] * np.array([-1, 1])
     n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     n /= np.linalg.norm(n, axis=1, keepdims=True) + 1e-12
