@@ -10,10 +10,12 @@ Needs only numpy. See README.md next to this file for what it does and what it p
 """
 
 import argparse
+import io
 import os
 import sys
 import tempfile
 import time
+import zipfile
 
 import numpy as np
 
@@ -27,8 +29,8 @@ import regressor  # noqa: E402
 import skeleton  # noqa: E402
 
 DECIMETRE = 0.1
-# SMPL's neutral template has its pelvis joint here; the mean body is moved so that its pelvis
-# joint lands on the same spot, so SMPL/AMASS root translations place it on the same floor.
+# About where SMPL's neutral template has its pelvis joint; the mean body is moved so that its
+# pelvis joint lands there, so SMPL/AMASS root translations put its feet near the same floor.
 SMPL_PELVIS = np.array([0.0, -0.2408, 0.0286])
 
 
@@ -89,13 +91,19 @@ def describe_components(scores, descriptors):
 
 
 def write_npz(path, arrays):
-    """Atomic write: a temporary file in the same folder, then a rename."""
+    """What `np.savez_compressed` writes, with fixed zip timestamps so that running the converter
+    again gives identical bytes; written atomically (a temporary file, then a rename)."""
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(dir=folder, suffix=".npz.tmp")
     os.close(fd)
     try:
-        with open(tmp, "wb") as f:
-            np.savez_compressed(f, **arrays)
+        with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+            for key, value in arrays.items():
+                info = zipfile.ZipInfo(key + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
+                info.compress_type = zipfile.ZIP_DEFLATED
+                buf = io.BytesIO()
+                np.lib.format.write_array(buf, np.asanyarray(value), allow_pickle=False)
+                zf.writestr(info, buf.getvalue())
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
@@ -222,8 +230,8 @@ def main():
         weights=weights[kept], uvs=uvs[lod_uv_ids], uv_faces=lod_uv_faces, shape_names=shape_names,
     )  # fmt: skip
 
-    # The same bodies with MakeHuman's average muscle and weight: the macro targets that leave
-    # the joint cubes in place (see regressor.py) then play no part.
+    # The same bodies with MakeHuman's average muscle and weight: the muscle/weight targets that
+    # leave the joint cubes in place (see regressor.py) then play no part.
     average_build = {**params, "muscle": np.full(args.samples, 0.5), "weight": np.full(args.samples, 0.5)}
     populations = {
         "sampled bodies": centred,

@@ -6,9 +6,11 @@ that sum to one (as SMPL's regressor), fitted by least squares so that they repr
 the mean body and on sampled body shapes, with a small ridge that spreads the weights. The
 solution of such a fit is naturally sparse.
 
-Convexity keeps the joints inside the body under any template edit, at a price: 35 of the
-MakeHuman muscle/weight targets move the surface by up to 9 cm but leave the joint cubes where
-they are, so no surface regressor follows the cube means exactly on bodies that use them.
+Convexity keeps the joints inside the body under any template edit, at a price: the MakeHuman
+targets do not always move the joint cubes with the surface. 35 of the muscle/weight targets
+move the surface by up to 9 cm but leave the cubes where they are, and the min-height targets
+lower the surface around the knee by 12 cm but the knee cube by 6 cm. No surface regressor
+follows the cube means exactly on bodies that use them; a convex one stays with the surface.
 """
 
 import numpy as np
