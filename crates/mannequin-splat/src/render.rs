@@ -150,7 +150,7 @@ pub(crate) fn validate<T: Real>(
     opts.validate(g.channels())
 }
 
-fn prepare<T: Real>(
+pub(crate) fn prepare<T: Real>(
     g: &Gaussians<T>,
     camera: &Camera,
     opts: &RenderOptions,
@@ -325,7 +325,6 @@ pub(crate) fn backward_checked<T: Real>(
     }
 
     let tiles = &prep.tiles;
-    let n = g.len();
     let stride = SCREEN_GRADS + ch;
     let rule = opts.rule::<T>();
     // One dense accumulator per worker thread; a worker holds its own lock for a whole tile.
@@ -364,11 +363,25 @@ pub(crate) fn backward_checked<T: Real>(
     );
     let bufs: Vec<Vec<T>> =
         bufs.into_iter().map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
+    let parts: Vec<&[T]> = bufs.iter().map(Vec::as_slice).collect();
+    Ok(screen_vjp(g, camera, &tiles.order, &parts, ch))
+}
+
+/// Chains screen-space gradients back to every Gaussian's parameters. `parts` hold, by depth
+/// rank (`order[rank]` is the Gaussian), `SCREEN_GRADS + channels` sums each; they are added up.
+pub(crate) fn screen_vjp<T: Real>(
+    g: &Gaussians<T>,
+    camera: &Camera,
+    order: &[u32],
+    parts: &[&[T]],
+    channels: usize,
+) -> GaussianGrads<T> {
+    let n = g.len();
+    let stride = SCREEN_GRADS + channels;
     let mut rank = vec![u32::MAX; n];
-    for (r, &i) in tiles.order.iter().enumerate() {
+    for (r, &i) in order.iter().enumerate() {
         rank[i as usize] = r as u32;
     }
-
     let cam = CameraParams::new(camera);
     let mut out_grads = GaussianGrads::zeros_like(g);
     let (rot_n, col_n) = (out_grads.rotations.len() / n.max(1), out_grads.colors.len() / n.max(1));
@@ -388,7 +401,7 @@ pub(crate) fn backward_checked<T: Real>(
                     return;
                 }
                 sum.fill(T::ZERO);
-                for b in &bufs {
+                for b in parts {
                     for (acc, v) in sum.iter_mut().zip(&b[at * stride..(at + 1) * stride]) {
                         *acc += *v;
                     }
@@ -403,5 +416,5 @@ pub(crate) fn backward_checked<T: Real>(
                 project_vjp(g, &cam, i, &sg, &sum[SCREEN_GRADS..], sum[5], basis, row);
             },
         );
-    Ok(out_grads)
+    out_grads
 }

@@ -39,6 +39,10 @@ enum Leaf {
 /// gradients with the CPU renderer on the same inputs.
 fn check(rot: RotForm, col: ColorForm, seed: u64) {
     let scene = Scene::random(40, seed, if let ColorForm::Sh(d) = col { d } else { 0 }, 4);
+    check_scene(&scene, rot, col, seed);
+}
+
+fn check_scene(scene: &Scene, rot: RotForm, col: ColorForm, seed: u64) {
     let cam = camera(32, 24);
     let opts = RenderOptions {
         background: vec![0.3; if let ColorForm::Features(c) = col { c } else { 3 }],
@@ -120,6 +124,28 @@ fn quaternions_and_sh_match_the_cpu_renderer_on_every_backend() {
 #[test]
 fn matrices_and_features_match_the_cpu_renderer_on_every_backend() {
     check(RotForm::Matrix, ColorForm::Features(4), 32);
+}
+
+/// A dense stack of nearly opaque Gaussians: pixels saturate (alpha capped) and stop early
+/// (transmittance floor), and the device kernels must replay exactly where the CPU did.
+#[test]
+fn saturated_pixels_match_the_cpu_renderer_on_every_backend() {
+    let mut scene = Scene::random(120, 33, 1, 3);
+    for i in 0..60 {
+        scene.opacities[i] = 0.97;
+        for k in 0..3 {
+            scene.means[3 * i + k] *= 0.3;
+        }
+    }
+    let s = scene.cast::<f32>();
+    let cpu = render(
+        &s.gaussians(RotForm::Quaternion, ColorForm::Sh(1)),
+        &camera(32, 24),
+        &RenderOptions::default(),
+    );
+    let opaque = cpu.unwrap().alpha.iter().filter(|&&a| a > 0.999).count();
+    assert!(opaque > 20, "only {opaque} pixels reach the transmittance floor");
+    check_scene(&scene, RotForm::Quaternion, ColorForm::Sh(1), 33);
 }
 
 /// Gradients reach tensors computed by Burn's own ops upstream, and a few steps of gradient

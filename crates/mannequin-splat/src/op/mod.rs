@@ -25,6 +25,7 @@ mod autodiff;
 mod cube;
 mod flex;
 mod host;
+mod kernels;
 mod saved;
 
 use burn::backend::tensor::FloatTensor;

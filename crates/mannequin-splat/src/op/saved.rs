@@ -16,9 +16,39 @@ fn int(v: f32) -> usize {
     v.to_bits() as usize
 }
 
-/// Flattens what [`crate::backward`] needs besides the images.
-pub(crate) fn encode(out: &RenderOutput<f32>) -> Vec<f32> {
-    let Saved { prep: Prepared { packed, tiles }, last } = &out.saved;
+/// Where each part of the flattened state starts, in words.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WordLayout {
+    pub stride: usize,
+    pub tiles_x: usize,
+    pub order: usize,
+    pub offsets: usize,
+    pub ids: usize,
+    pub rows: usize,
+    pub last: usize,
+    /// Gaussians in the depth order.
+    pub visible: usize,
+}
+
+impl WordLayout {
+    /// Reads the header.
+    pub fn parse(words: &[f32]) -> Option<Self> {
+        let h: Vec<usize> = words.get(..HEADER)?.iter().map(|&v| int(v)).collect();
+        let [stride, tiles_x, _tiles_y, n_order, n_offsets, n_ids, _n_last, n_rows] = h[..] else {
+            return None;
+        };
+        let order = HEADER;
+        let offsets = order + n_order;
+        let ids = offsets + n_offsets;
+        let rows = ids + n_ids;
+        Some(WordLayout { stride, tiles_x, order, offsets, ids, rows, last: rows + n_rows, visible: n_order })
+    }
+}
+
+/// Flattens the binning and packing (everything but the per-pixel replay lengths, which come
+/// last and are `npx` words long).
+pub(crate) fn encode_prepared(prep: &Prepared<f32>, npx: usize) -> Vec<f32> {
+    let Prepared { packed, tiles } = prep;
     let header = [
         packed.stride,
         tiles.tiles_x,
@@ -26,7 +56,7 @@ pub(crate) fn encode(out: &RenderOutput<f32>) -> Vec<f32> {
         tiles.order.len(),
         tiles.offsets.len(),
         tiles.ids.len(),
-        last.len(),
+        npx,
         packed.rows.len(),
     ];
     let mut w = Vec::with_capacity(HEADER + header[3..].iter().sum::<usize>());
@@ -34,8 +64,14 @@ pub(crate) fn encode(out: &RenderOutput<f32>) -> Vec<f32> {
     w.extend(tiles.order.iter().map(|&v| bits(v as usize)));
     w.extend(tiles.offsets.iter().map(|&v| bits(v)));
     w.extend(tiles.ids.iter().map(|&v| bits(v as usize)));
-    w.extend(last.iter().map(|&v| bits(v as usize)));
     w.extend_from_slice(&packed.rows);
+    w
+}
+
+/// Flattens what [`crate::backward`] needs besides the images.
+pub(crate) fn encode(out: &RenderOutput<f32>) -> Vec<f32> {
+    let mut w = encode_prepared(&out.saved.prep, out.saved.last.len());
+    w.extend(out.saved.last.iter().map(|&v| bits(v as usize)));
     w
 }
 
@@ -62,8 +98,8 @@ pub(crate) fn decode(
     let order = take(n_order)?.iter().map(|&v| int(v) as u32).collect();
     let offsets = take(n_offsets)?.iter().map(|&v| int(v)).collect();
     let ids = take(n_ids)?.iter().map(|&v| int(v) as u32).collect();
-    let last: Vec<u32> = take(n_last)?.iter().map(|&v| int(v) as u32).collect();
     let rows = take(n_rows)?.to_vec();
+    let last: Vec<u32> = take(n_last)?.iter().map(|&v| int(v) as u32).collect();
     if last.len() != npx || rendered.len() != (channels + 2) * npx {
         return None;
     }
