@@ -115,7 +115,8 @@ impl<T: Real> Gaussians<'_, T> {
 
     /// Whether every parameter of Gaussian `i` is finite.
     pub(crate) fn is_finite(&self, i: usize) -> bool {
-        let all = |s: &[T]| s.iter().all(|v| v.is_finite());
+        // v·0 is 0 for finite v and NaN otherwise; one sum checks a whole slice branch-free.
+        let all = |s: &[T]| s.iter().fold(T::ZERO, |acc, &v| acc + v * T::ZERO) == T::ZERO;
         let rot = match self.rotations {
             Rotations::Quaternions(q) => &q[4 * i..4 * i + 4],
             Rotations::Matrices(m) => &m[9 * i..9 * i + 9],
