@@ -229,3 +229,26 @@ fn mismatched_tensor_shapes_are_errors() {
     .expect("an error");
     assert!(matches!(err, SplatError::Shape { field: "rotations (quaternions)", .. }), "{err}");
 }
+
+/// No Gaussians at all: the background, and zero-length gradients.
+#[test]
+fn an_empty_scene_renders_the_background_on_every_backend() {
+    for (name, device) in devices() {
+        let device = device.autodiff();
+        let means = Tensor::<2>::zeros([0, 3], &device).require_grad();
+        let out = splat_render(
+            means.clone(),
+            RotationTensor::Quaternions(Tensor::zeros([0, 4], &device)),
+            Tensor::zeros([0, 3], &device),
+            Tensor::zeros([0], &device),
+            ColorTensor::Features(Tensor::zeros([0, 2], &device)),
+            &camera(20, 17),
+            &RenderOptions { background: vec![0.25, 0.5], ..Default::default() },
+        )
+        .unwrap();
+        let image = values(out.image.clone());
+        assert!(image[..340].iter().all(|&v| v == 0.25) && image[340..].iter().all(|&v| v == 0.5), "{name}");
+        let grads = (out.image.sum() + out.alpha.sum()).backward();
+        assert_eq!(means.grad(&grads).map(|g| g.dims()), Some([0, 3]), "{name}");
+    }
+}

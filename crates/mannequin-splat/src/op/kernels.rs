@@ -4,6 +4,11 @@
 //!
 //! Everything the CPU binning produced lives in one `f32` buffer (`words`, see `saved.rs`):
 //! integers are stored as bit patterns and read back with `u32::reinterpret`.
+//!
+//! Each unit loops over its tile's list. Mesa's lavapipe silently stops any shader loop after
+//! 65,535 iterations, so on lavapipe a tile must list fewer Gaussians than that (the tests do);
+//! real GPUs have no such limit. Gradient sums use `f32` atomics, so their last bits depend on
+//! the order the units run in.
 
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
