@@ -26,6 +26,7 @@ mod cube;
 mod flex;
 mod host;
 mod kernels;
+mod project_kernels;
 mod saved;
 
 use burn::backend::tensor::FloatTensor;

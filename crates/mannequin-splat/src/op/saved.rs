@@ -21,13 +21,10 @@ fn int(v: f32) -> usize {
 pub(crate) struct WordLayout {
     pub stride: usize,
     pub tiles_x: usize,
-    pub order: usize,
     pub offsets: usize,
     pub ids: usize,
     pub rows: usize,
     pub last: usize,
-    /// Gaussians in the depth order.
-    pub visible: usize,
 }
 
 impl WordLayout {
@@ -37,12 +34,22 @@ impl WordLayout {
         let [stride, tiles_x, _tiles_y, n_order, n_offsets, n_ids, _n_last, n_rows] = h[..] else {
             return None;
         };
-        let order = HEADER;
-        let offsets = order + n_order;
+        let offsets = HEADER + n_order;
         let ids = offsets + n_offsets;
         let rows = ids + n_ids;
-        Some(WordLayout { stride, tiles_x, order, offsets, ids, rows, last: rows + n_rows, visible: n_order })
+        Some(WordLayout { stride, tiles_x, offsets, ids, rows, last: rows + n_rows })
     }
+}
+
+/// The header and tile lists, followed by `rows` words of packed Gaussians and `last` words of
+/// replay lengths that the caller appends.
+pub(crate) fn encode_lists(header: [usize; 8], order: &[u32], offsets: &[usize], ids: &[u32]) -> Vec<f32> {
+    let mut w = Vec::with_capacity(HEADER + order.len() + offsets.len() + ids.len());
+    w.extend(header.map(bits));
+    w.extend(order.iter().map(|&v| bits(v as usize)));
+    w.extend(offsets.iter().map(|&v| bits(v)));
+    w.extend(ids.iter().map(|&v| bits(v as usize)));
+    w
 }
 
 /// Flattens the binning and packing (everything but the per-pixel replay lengths, which come
@@ -59,11 +66,7 @@ pub(crate) fn encode_prepared(prep: &Prepared<f32>, npx: usize) -> Vec<f32> {
         npx,
         packed.rows.len(),
     ];
-    let mut w = Vec::with_capacity(HEADER + header[3..].iter().sum::<usize>());
-    w.extend(header.map(bits));
-    w.extend(tiles.order.iter().map(|&v| bits(v as usize)));
-    w.extend(tiles.offsets.iter().map(|&v| bits(v)));
-    w.extend(tiles.ids.iter().map(|&v| bits(v as usize)));
+    let mut w = encode_lists(header, &tiles.order, &tiles.offsets, &tiles.ids);
     w.extend_from_slice(&packed.rows);
     w
 }
