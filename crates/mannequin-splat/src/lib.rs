@@ -6,7 +6,14 @@
 //! 1e-4. Colours are spherical harmonics up to degree 3 (3DGS's `+0.5` offset and clamp at 0) or
 //! arbitrary per-Gaussian features.
 //!
-//! ```no_run
+//! Three ways in:
+//! - [`render`] and [`backward`]: the CPU renderer on slices, generic over `f32`/`f64` (rayon,
+//!   16-lane rows, no per-pixel allocation);
+//! - [`splat_render`]: the same as a differentiable Burn op on tensors, on Flex (the CPU code in
+//!   place) and on the CubeCL backends (device kernels; binning on the host);
+//! - [`SplatScene`]: 3DGS `.ply` files in the INRIA layout.
+//!
+//! ```
 //! use mannequin_splat::{Camera, Colors, Gaussians, RenderOptions, Rotations, render};
 //! let camera = Camera::look_at([0.0, 1.0, 2.5], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0], 0.8, 64, 48);
 //! let g = Gaussians {
