@@ -95,18 +95,44 @@ pub fn forward_tensors(
 ) -> PosedTensors {
     let [n, _] = shape.dims();
     let [v, j] = bt.weights.dims();
-    let device = template.device();
-    let dtype = template.dtype();
 
     // T(β) = T̄ + S β, and J(β) = 𝒥 T(β).
-    let v_shaped = template.reshape([1, 3 * v]) + shape.matmul(bt.shapedirs.clone());
-    let v_shaped3: Tensor<3> = v_shaped.clone().reshape([n, v, 3]);
-    let joints_rest = bt.j_regressor.clone().unsqueeze_dim::<3>(0).expand([n, j, v]).matmul(v_shaped3);
+    let v_shaped: Tensor<3> =
+        (template.reshape([1, 3 * v]) + shape.matmul(bt.shapedirs.clone())).reshape([n, v, 3]);
+    let joints_rest = bt.j_regressor.clone().unsqueeze_dim::<3>(0).expand([n, j, v]).matmul(v_shaped.clone());
+    let rig = Rig { weights: &bt.weights, posedirs: bt.posedirs.as_ref(), parents: &bt.parents };
+    skin_tensors(&rig, v_shaped, joints_rest, pose, transl)
+}
+
+/// What skinning needs besides the shaped mesh: weights [V, J], optional pose correctives
+/// [9(J−1), 3V], and the joint tree.
+#[derive(Debug, Clone, Copy)]
+pub struct Rig<'a> {
+    pub weights: &'a Tensor<2>,
+    pub posedirs: Option<&'a Tensor<2>>,
+    pub parents: &'a [Option<usize>],
+}
+
+/// Poses shaped vertices [N, V, 3] about rest joints [N, J, 3] (Eq. 1 with pose correctives):
+/// the second half of [`forward_tensors`], for callers whose joints do not come from the
+/// regressor (an avatar keeps the body's joints under its clothing offsets, iHuman learns them).
+pub fn skin_tensors(
+    rig: &Rig,
+    v_shaped: Tensor<3>,
+    joints_rest: Tensor<3>,
+    pose: Tensor<2>,
+    transl: Tensor<2>,
+) -> PosedTensors {
+    let [n, v, _] = v_shaped.dims();
+    let j = rig.parents.len();
+    let device = v_shaped.device();
+    let dtype = v_shaped.dtype();
+    let v_shaped = v_shaped.reshape([n, 3 * v]);
 
     let rot = rodrigues_tensor(pose.reshape([n * j, 3])).reshape([n, j, 3, 3]);
 
     // T_P = T(β) + P (R(θ) − I), over joints 1..J.
-    let v_posed = match &bt.posedirs {
+    let v_posed = match rig.posedirs {
         Some(pd) => {
             let eye: Tensor<2> = Tensor::<2>::eye(3, &device).cast(dtype);
             let feat = rot.clone().narrow(1, 1, j - 1) - eye.reshape([1, 1, 3, 3]);
@@ -120,7 +146,7 @@ pub fn forward_tensors(
     let local_rot = |k: usize| rot.clone().narrow(1, k, 1).reshape([n, 3, 3]);
     let mut g_rot: Vec<Tensor<3>> = Vec::with_capacity(j);
     let mut g_t: Vec<Tensor<3>> = Vec::with_capacity(j);
-    for (k, parent) in bt.parents.iter().enumerate() {
+    for (k, parent) in rig.parents.iter().enumerate() {
         match parent {
             None => {
                 g_rot.push(local_rot(k));
@@ -140,7 +166,7 @@ pub fn forward_tensors(
     let rest = joints_rest.clone().reshape([n, j, 3, 1]);
     let a_t = world_t.clone() - world_rot.clone().matmul(rest);
     let a = Tensor::cat(vec![world_rot.clone().reshape([n, j, 9]), a_t.reshape([n, j, 3])], 2); // [N, J, 12]
-    let blended = bt.weights.clone().unsqueeze_dim::<3>(0).expand([n, v, j]).matmul(a); // [N, V, 12]
+    let blended = rig.weights.clone().unsqueeze_dim::<3>(0).expand([n, v, j]).matmul(a); // [N, V, 12]
     let b_rot: Tensor<4> = blended.clone().narrow(2, 0, 9).reshape([n, v, 3, 3]);
     let b_t: Tensor<3> = blended.narrow(2, 9, 3);
     let vp: Tensor<4> = v_posed.reshape([n, v, 3, 1]);

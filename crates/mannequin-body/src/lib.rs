@@ -17,7 +17,7 @@ pub mod walk_cycle;
 
 pub use error::BodyError;
 pub use lbs::{PosedFrames, ShapedBody, forward, pose_frames, shape_body};
-pub use lbs_tensor::{BodyTensors, PosedTensors, forward_tensors, rodrigues_tensor};
+pub use lbs_tensor::{BodyTensors, PosedTensors, Rig, forward_tensors, rodrigues_tensor, skin_tensors};
 pub use model::{BodyModel, BodyModelParts, ModelFamily};
 pub use motion::Motion;
 pub use named_pose::{POSE_NAMES, named_pose};

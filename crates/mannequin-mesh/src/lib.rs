@@ -10,6 +10,7 @@ pub mod mass;
 pub mod normals;
 pub mod obj;
 pub mod ply;
+pub mod subdivide;
 pub mod tri_mesh;
 
 pub use area::double_areas;

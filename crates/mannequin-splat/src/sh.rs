@@ -60,6 +60,37 @@ pub fn basis<T: Real>(degree: usize, d: [T; 3], out: &mut [T]) {
     out[15] = c(C3_A) * fc2;
 }
 
+/// The basis of degree ≤ 2 at unit directions `d` [N, 3], as a differentiable tensor [N, (d+1)²]:
+/// callers that composite colours as features (several channels in one pass) evaluate the SH
+/// themselves and still get gradients through the view direction.
+pub fn basis_tensor(
+    degree: usize,
+    d: burn::tensor::Tensor<2>,
+) -> Result<burn::tensor::Tensor<2>, crate::SplatError> {
+    use burn::tensor::Tensor;
+    if degree > 2 {
+        return Err(crate::SplatError::Options(format!(
+            "tensor SH basis supports degrees 0 to 2, not {degree}"
+        )));
+    }
+    let col = |k: usize| d.clone().narrow(1, k, 1);
+    let (x, y, z) = (col(0), col(1), col(2));
+    let mut out = vec![x.ones_like() * C0];
+    if degree >= 1 {
+        out.extend([y.clone() * -C1, z.clone() * C1, x.clone() * -C1]);
+    }
+    if degree >= 2 {
+        out.extend([
+            x.clone() * y.clone() * (2.0 * C2_XY),
+            z.clone() * y.clone() * -C2_Z,
+            z.clone().square() * C2_ZZ - C2_0,
+            z * x.clone() * -C2_Z,
+            (x.square() - y.square()) * C2_XY,
+        ]);
+    }
+    Ok(Tensor::cat(out, 1))
+}
+
 /// `Σ_k g_k ∇Y_k(d)`: the gradient with respect to `(x, y, z)` of the basis polynomials,
 /// contracted with per-basis weights `g` (for colour, `g_k = Σ_c sh_kc · dL/dcolour_c`).
 pub fn basis_vjp<T: Real>(degree: usize, d: [T; 3], g: &[T]) -> [T; 3] {

@@ -1,1 +1,0 @@
-//! Multi-resolution hash encoding (instant-ngp).
