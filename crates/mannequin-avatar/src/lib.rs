@@ -2,5 +2,24 @@
 //! field (Tavatar Eq. 4), posed by LBS, carrying Gaussians derived from the posed mesh and
 //! rendered by differentiable splatting.
 
+pub mod adam;
+pub mod avatar;
+pub mod canonical;
+pub mod config;
+pub mod error;
+pub mod field;
 pub mod hash_grid;
+pub mod ihuman;
 pub mod losses;
+pub mod mesh_gaussians;
+pub mod mlp;
+pub mod params;
+pub mod trainer;
+pub mod views;
+
+pub use avatar::{Avatar, Posed, Rendered};
+pub use canonical::Canonical;
+pub use config::{AvatarConfig, Method};
+pub use error::AvatarError;
+pub use trainer::{StepStats, Timings, TrainOptions, Trainer};
+pub use views::{View, load_views, splat_camera};

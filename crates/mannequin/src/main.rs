@@ -9,6 +9,7 @@ mod motion;
 mod progress;
 mod splat;
 mod synth;
+mod train;
 
 use clap::{Parser, Subcommand};
 
@@ -40,6 +41,8 @@ enum Command {
     Synth(synth::Args),
     /// Render a 3D Gaussian splatting .ply through a camera, or summarise one.
     Splat(splat::Args),
+    /// Reconstruct an animatable avatar from a dataset (Tavatar or iHuman binding).
+    Train(train::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -53,6 +56,7 @@ fn main() -> std::process::ExitCode {
         Command::Eval(args) => eval::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Splat(args) => splat::run(args),
+        Command::Train(args) => train::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

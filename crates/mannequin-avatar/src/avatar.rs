@@ -1,0 +1,345 @@
+//! The avatar: canonical mesh + hash-grid offsets (Tavatar Eq. 4), posed by LBS (Eq. 1),
+//! carrying Gaussians bound to the posed mesh, rendered as colour and camera-space normals in
+//! one splatting pass.
+
+use std::path::Path;
+
+use burn::tensor::{Device, Tensor};
+use mannequin_body::{Rig, skin_tensors};
+use mannequin_io::{Npz, NpzWriter, write_atomic};
+use mannequin_splat::{Camera, ColorTensor, RenderOptions, RotationTensor, sh, splat_render};
+
+use crate::canonical::Canonical;
+use crate::config::{AvatarConfig, Method};
+use crate::error::AvatarError;
+use crate::field::Field;
+use crate::ihuman;
+use crate::mesh_gaussians::{GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
+use crate::params::{Param, tensor_from};
+use mannequin_data::rng::SplitMix64;
+
+/// Background of the colour channels: white, as the peers train and evaluate.
+pub const WHITE: [f64; 3] = [1.0; 3];
+
+/// File names inside a model directory.
+pub const CONFIG_FILE: &str = "avatar.json";
+pub const PARAMS_FILE: &str = "avatar.npz";
+
+/// The learned parts that are not fields, by index into `Avatar::params`.
+#[derive(Clone, Debug, Default)]
+struct Slots {
+    /// Tavatar: SH coefficients [G, 3(d+1)²], basis-major.
+    sh: Option<usize>,
+    /// Tavatar w/o FG: log in-plane scales of vertex Gaussians [V, 2].
+    vertex_log_scales: Option<usize>,
+    /// iHuman: log in-plane scales (s2, s3) [F, 2], in-plane rotation (x, y) [F, 2], joints [J, 3].
+    face_log_scales: Option<usize>,
+    face_rotation: Option<usize>,
+    joints: Option<usize>,
+}
+
+pub struct Avatar {
+    pub config: AvatarConfig,
+    pub canonical: Canonical,
+    pub params: Vec<Param>,
+    device: Device,
+    index: MeshIndex,
+    vertices: Tensor<2>,
+    weights: Tensor<2>,
+    posedirs: Option<Tensor<2>>,
+    rest_joints: Tensor<2>,
+    offsets: Field,
+    /// iHuman's colour encoder over canonical face centroids.
+    colour_field: Option<Field>,
+    slots: Slots,
+}
+
+/// A posed avatar: its mesh and Gaussians, still differentiable.
+#[derive(Clone, Debug)]
+pub struct Posed {
+    /// Personalised canonical vertices V_s [V, 3] (Eq. 4).
+    pub personalised: Tensor<2>,
+    /// Posed vertices V_p [V, 3].
+    pub vertices: Tensor<2>,
+    pub gaussians: GaussianGeometry,
+}
+
+/// Rendered maps: colour over white [3, H, W], camera-space normals over zero [3, H, W], alpha
+/// and expected depth [H, W].
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    pub rgb: Tensor<3>,
+    pub normals: Tensor<3>,
+    pub alpha: Tensor<2>,
+    pub depth: Tensor<2>,
+}
+
+fn flat(v: &[[f32; 3]]) -> Vec<f32> {
+    v.iter().flatten().copied().collect()
+}
+
+impl Avatar {
+    /// A fresh avatar on `device` (an autodiff device for training) with seeded initialisation.
+    pub fn new(config: AvatarConfig, canonical: Canonical, device: &Device) -> Result<Self, AvatarError> {
+        if config.sh_degree > 2 {
+            return Err(AvatarError::Invalid(format!("SH degree {} (0 to 2 supported)", config.sh_degree)));
+        }
+        if config.method == Method::Tavatar && !config.face_gaussians && !config.vertex_gaussians {
+            return Err(AvatarError::Invalid(
+                "face and vertex Gaussians are both off: nothing to render".into(),
+            ));
+        }
+        let (v, f) = (canonical.num_vertices(), canonical.faces.len());
+        let mut rng = SplitMix64::new(config.seed);
+        let mut params = Vec::new();
+        let offsets =
+            Field::new("offsets", &config, &canonical.vertices, 3, 1e-3, &mut rng, device, &mut params)?;
+        let mut slots = Slots::default();
+        let mut colour_field = None;
+        match config.method {
+            Method::Tavatar => {
+                let g = usize::from(config.face_gaussians) * f + usize::from(config.vertex_gaussians) * v;
+                let k = 3 * sh::basis_len(config.sh_degree);
+                params.push(Param::new("sh", tensor_from(vec![0.0; g * k], g, k, device), 1e-3));
+                slots.sh = Some(params.len() - 1);
+                if !config.face_gaussians {
+                    let init = ihuman::log_edge_scales(&canonical);
+                    params.push(Param::new("vertex_log_scales", tensor_from(init, v, 2, device), 1e-3));
+                    slots.vertex_log_scales = Some(params.len() - 1);
+                }
+            }
+            Method::Ihuman => {
+                let centroids = ihuman::face_centroids(&canonical);
+                colour_field =
+                    Some(Field::new("colour", &config, &centroids, 3, 5e-4, &mut rng, device, &mut params)?);
+                let init = ihuman::log_inradius_scales(&canonical);
+                params.push(Param::new("face_log_scales", tensor_from(init, f, 2, device), 5e-3));
+                slots.face_log_scales = Some(params.len() - 1);
+                let identity: Vec<f32> = (0..f).flat_map(|_| [1.0, 0.0]).collect();
+                params.push(Param::new("face_rotation", tensor_from(identity, f, 2, device), 5e-3));
+                slots.face_rotation = Some(params.len() - 1);
+                let j = canonical.num_joints();
+                params.push(Param::new("joints", tensor_from(flat(&canonical.joints), j, 3, device), 5e-4));
+                slots.joints = Some(params.len() - 1);
+            }
+        }
+        let j = canonical.num_joints();
+        let posedirs = (!canonical.posedirs.is_empty()).then(|| {
+            tensor_from(canonical.posedirs.clone(), canonical.posedirs.len() / (3 * v), 3 * v, device)
+        });
+        Ok(Self {
+            index: MeshIndex::new(v, &canonical.faces, device),
+            vertices: tensor_from(flat(&canonical.vertices), v, 3, device),
+            weights: tensor_from(canonical.weights.clone(), v, j, device),
+            rest_joints: tensor_from(flat(&canonical.joints), j, 3, device),
+            posedirs,
+            offsets,
+            colour_field,
+            slots,
+            params,
+            device: device.clone(),
+            config,
+            canonical,
+        })
+    }
+
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    pub fn mesh_index(&self) -> &MeshIndex {
+        &self.index
+    }
+
+    pub fn num_gaussians(&self) -> usize {
+        let (v, f) = (self.canonical.num_vertices(), self.canonical.faces.len());
+        match self.config.method {
+            Method::Tavatar => {
+                usize::from(self.config.face_gaussians) * f + usize::from(self.config.vertex_gaussians) * v
+            }
+            Method::Ihuman => f,
+        }
+    }
+
+    fn param(&self, slot: Option<usize>) -> Option<Tensor<2>> {
+        slot.map(|i| self.params[i].value.clone())
+    }
+
+    /// The offset field E_s(V_c) [V, 3] (Eq. 4).
+    pub fn offsets(&self) -> Result<Tensor<2>, AvatarError> {
+        self.offsets.forward(&self.params)
+    }
+
+    /// V_s = V_c + E_s(V_c) (Eq. 4).
+    pub fn personalised(&self, offsets: Tensor<2>) -> Tensor<2> {
+        self.vertices.clone() + offsets
+    }
+
+    /// LBS of personalised vertices (Eq. 1): `pose` is the body's axis-angle vector (3J),
+    /// `transl` the root translation.
+    pub fn skin(
+        &self,
+        personalised: Tensor<2>,
+        pose: &[f32],
+        transl: [f32; 3],
+    ) -> Result<Tensor<2>, AvatarError> {
+        let j = self.canonical.num_joints();
+        if pose.len() != 3 * j {
+            return Err(AvatarError::Invalid(format!(
+                "pose has {} values, the body has {j} joints ({})",
+                pose.len(),
+                3 * j
+            )));
+        }
+        if let Some(i) = pose.iter().chain(&transl).position(|x| !x.is_finite()) {
+            return Err(AvatarError::Invalid(format!("pose value {i} is not finite")));
+        }
+        let v = self.canonical.num_vertices();
+        let joints = self.param(self.slots.joints).unwrap_or_else(|| self.rest_joints.clone());
+        let rig = Rig {
+            weights: &self.weights,
+            posedirs: self.posedirs.as_ref(),
+            parents: &self.canonical.parents,
+        };
+        let posed = skin_tensors(
+            &rig,
+            personalised.reshape([1, v, 3]),
+            joints.reshape([1, j, 3]),
+            tensor_from(pose.to_vec(), 1, 3 * j, &self.device),
+            tensor_from(transl.to_vec(), 1, 3, &self.device),
+        );
+        Ok(posed.vertices.reshape([v, 3]))
+    }
+
+    /// Poses the avatar and binds its Gaussians.
+    pub fn pose(&self, pose: &[f32], transl: [f32; 3]) -> Result<Posed, AvatarError> {
+        let personalised = self.personalised(self.offsets()?);
+        let vertices = self.skin(personalised.clone(), pose, transl)?;
+        let gaussians = self.bind(&vertices);
+        Ok(Posed { personalised, vertices, gaussians })
+    }
+
+    /// Gaussians on posed vertices, by the configured binding.
+    pub fn bind(&self, vertices: &Tensor<2>) -> GaussianGeometry {
+        match self.config.method {
+            Method::Tavatar => {
+                let mut vertex =
+                    self.config.vertex_gaussians.then(|| vertex_gaussians(vertices, &self.index));
+                if let (Some(vg), Some(ls)) = (vertex.as_mut(), self.param(self.slots.vertex_log_scales)) {
+                    // Tavatar §5.3 "w/o FG": vertex scales become learnable.
+                    let eps = vg.scales.clone().narrow(1, 2, 1);
+                    vg.scales = Tensor::cat(vec![ls.exp(), eps], 1);
+                }
+                let face = self.config.face_gaussians.then(|| face_gaussians(vertices, &self.index));
+                match (face, vertex) {
+                    (Some(f), Some(v)) => GaussianGeometry::cat(f, v),
+                    (Some(f), None) => f,
+                    (None, Some(v)) => v,
+                    (None, None) => unreachable!("rejected in Avatar::new"),
+                }
+            }
+            Method::Ihuman => ihuman::centroid_gaussians(
+                vertices,
+                &self.index,
+                self.param(self.slots.face_rotation).expect("iHuman has rotations"),
+                self.param(self.slots.face_log_scales).expect("iHuman has scales"),
+            ),
+        }
+    }
+
+    /// Per-Gaussian RGB [G, 3] seen from `eye` (view-dependent through the SH).
+    pub fn colours(&self, gaussians: &GaussianGeometry, eye: [f64; 3]) -> Result<Tensor<2>, AvatarError> {
+        let rgb = match self.config.method {
+            Method::Tavatar => {
+                let coeffs = self.param(self.slots.sh).expect("Tavatar has SH");
+                let g = gaussians.len();
+                let k = sh::basis_len(self.config.sh_degree);
+                let eye = Tensor::<2>::from_data(
+                    burn::tensor::TensorData::new(eye.map(|x| x as f32).to_vec(), [1, 3]),
+                    &self.device,
+                );
+                let d = gaussians.means.clone() - eye;
+                let d = d.clone() / (d.square().sum_dim(1) + 1e-20).sqrt();
+                let basis = sh::basis_tensor(self.config.sh_degree, d)?; // [G, k]
+                let rgb = basis.unsqueeze_dim::<3>(2) * coeffs.reshape([g, k, 3]);
+                rgb.sum_dim(1).reshape([g, 3])
+            }
+            Method::Ihuman => {
+                self.colour_field.as_ref().expect("iHuman has a colour field").forward(&self.params)?
+            }
+        };
+        // 3DGS's colour convention: SH value + 0.5, clamped at zero.
+        Ok((rgb + 0.5).clamp_min(0.0))
+    }
+
+    /// Renders colour over white and camera-space normals over zero in one pass of six channels.
+    pub fn render(&self, posed: &Posed, camera: &Camera) -> Result<Rendered, AvatarError> {
+        let g = &posed.gaussians;
+        let n = g.len();
+        let rgb = self.colours(g, camera.centre())?;
+        let r = camera.extrinsic;
+        let rt: Vec<f32> = (0..3).flat_map(|i| (0..3).map(move |j| r[j][i] as f32)).collect();
+        let normals_cam = g.normals.clone().matmul(tensor_from(rt, 3, 3, &self.device));
+        let features = Tensor::cat(vec![rgb, normals_cam], 1);
+        let options = RenderOptions {
+            background: vec![WHITE[0], WHITE[1], WHITE[2], 0.0, 0.0, 0.0],
+            ..RenderOptions::default()
+        };
+        let opacities = Tensor::<1>::ones([n], &self.device);
+        let out = splat_render(
+            g.means.clone(),
+            RotationTensor::Matrices(g.frames.clone()),
+            g.scales.clone(),
+            opacities,
+            ColorTensor::Features(features),
+            camera,
+            &options,
+        )?;
+        Ok(Rendered {
+            rgb: out.image.clone().narrow(0, 0, 3),
+            normals: out.image.narrow(0, 3, 3),
+            alpha: out.alpha,
+            depth: out.depth,
+        })
+    }
+
+    /// Writes `avatar.json` and `avatar.npz` (canonical body + parameters) into `dir`, each
+    /// atomically.
+    pub fn save(&self, dir: &Path) -> Result<(), AvatarError> {
+        std::fs::create_dir_all(dir).map_err(|e| AvatarError::file(dir, e.to_string()))?;
+        let json = serde_json::to_string_pretty(&self.config).expect("config serialises");
+        let path = dir.join(CONFIG_FILE);
+        write_atomic(&path, json.as_bytes()).map_err(|e| AvatarError::file(&path, e.to_string()))?;
+        let mut w = NpzWriter::new();
+        self.canonical.write(&mut w);
+        for p in &self.params {
+            p.save(&mut w, "param/");
+        }
+        w.write(dir.join(PARAMS_FILE))?;
+        Ok(())
+    }
+
+    /// Loads a model directory written by [`Avatar::save`] onto `device`.
+    pub fn load(dir: &Path, device: &Device) -> Result<Self, AvatarError> {
+        let path = dir.join(CONFIG_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            AvatarError::file(&path, format!("{e} (is this a model directory written by `mannequin train`?)"))
+        })?;
+        let config: AvatarConfig =
+            serde_json::from_str(&text).map_err(|e| AvatarError::file(&path, e.to_string()))?;
+        let npz_path = dir.join(PARAMS_FILE);
+        let npz = Npz::read(&npz_path)?;
+        let canonical = Canonical::read(&npz, &npz_path)?;
+        let mut avatar = Self::new(config, canonical, device)?;
+        avatar.load_params(&npz, "param/", &npz_path)?;
+        Ok(avatar)
+    }
+
+    /// Replaces every parameter with `{prefix}{name}` from `npz`.
+    pub fn load_params(&mut self, npz: &Npz, prefix: &str, path: &Path) -> Result<(), AvatarError> {
+        for p in &mut self.params {
+            p.load(npz, prefix, path)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,135 @@
+//! The subject's body at rest: the model's template shaped by the dataset's β, pose-free, with
+//! its rig, optionally midpoint-subdivided for more Gaussians. A model directory stores it, so a
+//! trained avatar needs neither the body-model file nor the dataset again.
+
+use std::path::Path;
+
+use mannequin_body::{BodyModel, lbs::shape_body};
+use mannequin_io::{NpyArray, Npz, NpzWriter};
+use mannequin_mesh::subdivide::Subdivision;
+
+use crate::error::AvatarError;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Canonical {
+    /// Shaped template, [V] xyz.
+    pub vertices: Vec<[f32; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    /// Skinning weights, V × J row-major.
+    pub weights: Vec<f32>,
+    /// Rest joints of the shaped body.
+    pub joints: Vec<[f32; 3]>,
+    pub parents: Vec<Option<usize>>,
+    /// Pose correctives, 9(J−1) × 3V, or empty.
+    pub posedirs: Vec<f32>,
+}
+
+impl Canonical {
+    /// Shapes `model` by `betas` (zero-padded) and subdivides `subdivisions` times.
+    pub fn from_body(model: &BodyModel, betas: &[f32], subdivisions: usize) -> Result<Self, AvatarError> {
+        let shaped = shape_body(model, betas)?;
+        let mut c = Self {
+            vertices: shaped.vertices.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect(),
+            faces: model.faces.clone(),
+            weights: model.weights().to_vec(),
+            joints: shaped.joints.iter().map(|j| j.to_array()).collect(),
+            parents: model.parents().to_vec(),
+            posedirs: model.posedirs().to_vec(),
+        };
+        for _ in 0..subdivisions {
+            c = c.subdivided();
+        }
+        Ok(c)
+    }
+
+    pub fn num_vertices(&self) -> usize {
+        self.vertices.len()
+    }
+
+    pub fn num_joints(&self) -> usize {
+        self.parents.len()
+    }
+
+    /// One level of midpoint subdivision; weights and pose correctives interpolate linearly.
+    pub fn subdivided(&self) -> Self {
+        let v = self.num_vertices();
+        let s = Subdivision::new(v, &self.faces);
+        let flat: Vec<f32> = self.vertices.iter().flatten().copied().collect();
+        let vertices = s.interpolate(&flat, 3).chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        let posedirs = if self.posedirs.is_empty() {
+            Vec::new()
+        } else {
+            // Rows are pose features, columns 3V: interpolate each row as V triples.
+            self.posedirs.chunks_exact(3 * v).flat_map(|row| s.interpolate(row, 3)).collect()
+        };
+        let weights = s.interpolate(&self.weights, self.num_joints());
+        Self {
+            vertices,
+            faces: s.faces,
+            weights,
+            joints: self.joints.clone(),
+            parents: self.parents.clone(),
+            posedirs,
+        }
+    }
+
+    pub fn write(&self, w: &mut NpzWriter) {
+        let (v, j) = (self.num_vertices(), self.num_joints());
+        w.add("vertices", NpyArray::f32(vec![v, 3], self.vertices.iter().flatten().copied().collect()));
+        w.add(
+            "faces",
+            NpyArray::i64(
+                vec![self.faces.len(), 3],
+                self.faces.iter().flatten().map(|&i| i as i64).collect(),
+            ),
+        );
+        w.add("weights", NpyArray::f32(vec![v, j], self.weights.clone()));
+        w.add("joints", NpyArray::f32(vec![j, 3], self.joints.iter().flatten().copied().collect()));
+        w.add(
+            "parents",
+            NpyArray::i64(vec![j], self.parents.iter().map(|p| p.map_or(-1, |p| p as i64)).collect()),
+        );
+        let rows = if self.posedirs.is_empty() { 0 } else { self.posedirs.len() / (3 * v) };
+        w.add("posedirs", NpyArray::f32(vec![rows, 3 * v], self.posedirs.clone()));
+    }
+
+    /// Reads what [`Canonical::write`] wrote, checking every shape against the vertex and joint
+    /// counts.
+    pub fn read(npz: &Npz, path: &Path) -> Result<Self, AvatarError> {
+        let f32s = |key: &str, shape: &[Option<usize>]| -> Result<(Vec<usize>, Vec<f32>), AvatarError> {
+            let (s, d) = npz.f64_with_shape(key, shape)?;
+            Ok((s, d.into_iter().map(|x| x as f32).collect()))
+        };
+        let (_, vertices) = f32s("vertices", &[None, Some(3)])?;
+        let v = vertices.len() / 3;
+        let (_, joints) = f32s("joints", &[None, Some(3)])?;
+        let j = joints.len() / 3;
+        let (_, weights) = f32s("weights", &[Some(v), Some(j)])?;
+        let (_, posedirs) = f32s("posedirs", &[None, Some(3 * v)])?;
+        let (_, faces) = npz.f64_with_shape("faces", &[None, Some(3)])?;
+        let (_, parents) = npz.f64_with_shape("parents", &[Some(j)])?;
+        let bad = |field: &str, reason: String| AvatarError::file(path, format!("{field}: {reason}"));
+        let faces: Vec<[u32; 3]> = faces
+            .chunks_exact(3)
+            .enumerate()
+            .map(|(i, f)| {
+                if f.iter().all(|&x| x >= 0.0 && (x as usize) < v) {
+                    Ok([f[0] as u32, f[1] as u32, f[2] as u32])
+                } else {
+                    Err(bad("faces", format!("face {i} indexes past the {v} vertices")))
+                }
+            })
+            .collect::<Result<_, _>>()?;
+        let parents = parents
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| match p {
+                p if p < 0.0 => Ok(None),
+                p if (p as usize) < k => Ok(Some(p as usize)),
+                _ => Err(bad("parents", format!("joint {k} has parent {p}, expected an earlier joint"))),
+            })
+            .collect::<Result<_, _>>()?;
+        let triples = |x: Vec<f32>| x.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        Ok(Self { vertices: triples(vertices), faces, weights, joints: triples(joints), parents, posedirs })
+    }
+}

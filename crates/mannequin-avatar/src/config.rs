@@ -1,0 +1,69 @@
+//! What an avatar is made of, saved next to its parameters as `avatar.json`.
+
+use serde::{Deserialize, Serialize};
+
+/// How Gaussians are bound to the mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Tavatar: attributes derived analytically from the posed mesh; only colour is learned.
+    Tavatar,
+    /// iHuman: face-centroid Gaussians with learned in-plane rotation and scales, a hash-grid
+    /// colour encoder and learned joints.
+    Ihuman,
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "tavatar" => Ok(Self::Tavatar),
+            "ihuman" => Ok(Self::Ihuman),
+            _ => Err(format!("unknown method '{s}' (expected tavatar or ihuman)")),
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AvatarConfig {
+    pub method: Method,
+    /// Tavatar's face Gaussians (Eqs. 5–8); off for the "w/o FG" ablation.
+    pub face_gaussians: bool,
+    /// Tavatar's vertex Gaussians (Eqs. 9–11); off for the "w/o VG" ablation.
+    pub vertex_gaussians: bool,
+    /// Midpoint subdivisions of the body template.
+    pub subdivisions: usize,
+    /// SH degree of Tavatar's per-Gaussian colour.
+    pub sh_degree: usize,
+    /// Hash-grid levels, log2 table size, base resolution, growth, features per level.
+    pub hash_levels: usize,
+    pub hash_log2_table: u32,
+    pub hash_base_resolution: u32,
+    pub hash_growth: f64,
+    pub hash_features: usize,
+    /// Width of the MLPs' two hidden layers.
+    pub hidden: usize,
+    /// Seed of every random initialisation.
+    pub seed: u64,
+}
+
+impl AvatarConfig {
+    /// The seeds' settings for `method`.
+    pub fn new(method: Method, seed: u64) -> Self {
+        Self {
+            method,
+            face_gaussians: true,
+            vertex_gaussians: method == Method::Tavatar,
+            subdivisions: 0,
+            sh_degree: 2,
+            hash_levels: 16,
+            hash_log2_table: 17,
+            hash_base_resolution: 4,
+            hash_growth: 1.5,
+            // iHuman supplement §1.1: 4 features per entry; instant-ngp's default of 2 otherwise.
+            hash_features: if method == Method::Ihuman { 4 } else { 2 },
+            hidden: 64,
+            seed,
+        }
+    }
+}

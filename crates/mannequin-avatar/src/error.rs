@@ -1,0 +1,29 @@
+//! Errors that say which file, field or iteration went wrong, so a user can act on them.
+
+use std::path::PathBuf;
+
+#[derive(Debug, thiserror::Error)]
+pub enum AvatarError {
+    #[error(transparent)]
+    Io(#[from] mannequin_io::IoError),
+    #[error(transparent)]
+    Data(#[from] mannequin_data::DataError),
+    #[error(transparent)]
+    Body(#[from] mannequin_body::BodyError),
+    #[error(transparent)]
+    Splat(#[from] mannequin_splat::SplatError),
+    #[error(transparent)]
+    HashGrid(#[from] crate::hash_grid::HashGridError),
+    #[error("{path}: {reason}")]
+    File { path: PathBuf, reason: String },
+    #[error("{0}")]
+    Invalid(String),
+    #[error("the loss became {value} at iteration {iteration}; the last good checkpoint is {checkpoint}")]
+    NonFiniteLoss { iteration: usize, value: f64, checkpoint: String },
+}
+
+impl AvatarError {
+    pub fn file(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
+        Self::File { path: path.into(), reason: reason.into() }
+    }
+}

@@ -1,0 +1,185 @@
+//! Tavatar §4.2: Gaussians whose centre, frame and scale are analytic functions of the posed
+//! mesh, so every geometric attribute follows the surface and carries gradients back to the
+//! vertices (and from there to the offset field E_s).
+
+use burn::tensor::{Device, IndexingUpdateOp, Int, Tensor, TensorData};
+
+/// In-plane scale factor of face Gaussians, β in Eq. 8.
+pub const FACE_SCALE: f64 = 0.5;
+/// In-plane scale factor of vertex Gaussians, γ in Eq. 11.
+pub const VERTEX_SCALE: f64 = 0.5;
+/// Out-of-plane scale ε of Eqs. 8 and 11: flat disks.
+pub const NORMAL_SCALE: f64 = 1e-3;
+
+/// Keeps norms differentiable at zero-length vectors (degenerate faces).
+const NORM_EPS: f64 = 1e-20;
+
+/// Gaussian geometry on a device: centres [G, 3], frames [G, 3, 3] whose columns are
+/// (t1, t2, n), scales [G, 3], and the unit normal [G, 3] (the third column, kept for normal
+/// rendering).
+#[derive(Clone, Debug)]
+pub struct GaussianGeometry {
+    pub means: Tensor<2>,
+    pub frames: Tensor<3>,
+    pub scales: Tensor<2>,
+    pub normals: Tensor<2>,
+}
+
+impl GaussianGeometry {
+    /// Both sets as one, face Gaussians first.
+    pub fn cat(a: Self, b: Self) -> Self {
+        Self {
+            means: Tensor::cat(vec![a.means, b.means], 0),
+            frames: Tensor::cat(vec![a.frames, b.frames], 0),
+            scales: Tensor::cat(vec![a.scales, b.scales], 0),
+            normals: Tensor::cat(vec![a.normals, b.normals], 0),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.means.dims()[0]
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Index tensors of a fixed-topology mesh: the three corners of every face, and each vertex's
+/// one-ring padded to the largest valence (padding marked in `ring_pad`).
+#[derive(Clone, Debug)]
+pub struct MeshIndex {
+    pub num_vertices: usize,
+    pub corners: [Tensor<1, Int>; 3],
+    /// [V · valence] neighbour indices, row-major; padding repeats the vertex itself.
+    pub ring: Tensor<1, Int>,
+    /// [V, valence], 1 where `ring` is padding.
+    pub ring_pad: Tensor<2>,
+    pub valence: usize,
+}
+
+impl MeshIndex {
+    /// Builds the index tensors; faces must already be validated against `num_vertices`.
+    pub fn new(num_vertices: usize, faces: &[[u32; 3]], device: &Device) -> Self {
+        let corner = |k: usize| {
+            let idx: Vec<i64> = faces.iter().map(|f| f[k] as i64).collect();
+            Tensor::<1, Int>::from_data(TensorData::new(idx, [faces.len()]), device)
+        };
+        let mut rings: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
+        for f in faces {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                rings[a as usize].push(b);
+                rings[b as usize].push(a);
+            }
+        }
+        for r in &mut rings {
+            r.sort_unstable();
+            r.dedup();
+        }
+        let valence = rings.iter().map(Vec::len).max().unwrap_or(0).max(1);
+        let mut ring = Vec::with_capacity(num_vertices * valence);
+        let mut pad = Vec::with_capacity(num_vertices * valence);
+        for (v, r) in rings.iter().enumerate() {
+            for k in 0..valence {
+                ring.push(r.get(k).map_or(v as i64, |&n| n as i64));
+                pad.push(if k < r.len() { 0.0f32 } else { 1.0 });
+            }
+        }
+        Self {
+            num_vertices,
+            corners: [corner(0), corner(1), corner(2)],
+            ring: Tensor::from_data(TensorData::new(ring, [num_vertices * valence]), device),
+            ring_pad: Tensor::from_data(TensorData::new(pad, [num_vertices, valence]), device),
+            valence,
+        }
+    }
+
+    /// The face corners of `vertices` [V, 3], each [F, 3].
+    pub fn corner_positions(&self, vertices: &Tensor<2>) -> [Tensor<2>; 3] {
+        self.corners.clone().map(|c| vertices.clone().select(0, c))
+    }
+}
+
+/// ‖x‖ per row, [N, 1].
+fn row_norm(x: Tensor<2>) -> Tensor<2> {
+    (x.square().sum_dim(1) + NORM_EPS).sqrt()
+}
+
+/// Unit rows.
+fn normalise(x: Tensor<2>) -> Tensor<2> {
+    x.clone() / row_norm(x)
+}
+
+/// A frame with columns (t1, t2, n), [N, 3, 3].
+fn frame(t1: Tensor<2>, t2: Tensor<2>, n: Tensor<2>) -> Tensor<3> {
+    Tensor::stack(vec![t1, t2, n], 2)
+}
+
+/// Disk scales (s, s, ε) from an in-plane scale [N, 1].
+fn disk_scales(in_plane: Tensor<2>) -> Tensor<2> {
+    let eps = in_plane.zeros_like() + NORMAL_SCALE;
+    Tensor::cat(vec![in_plane.clone(), in_plane, eps], 1)
+}
+
+/// Face Gaussians (Eqs. 5–8) of posed vertices [V, 3].
+pub fn face_gaussians(vertices: &Tensor<2>, index: &MeshIndex) -> GaussianGeometry {
+    let [a, b, c] = index.corner_positions(vertices);
+    // Edge lengths opposite each corner.
+    let la = row_norm(b.clone() - c.clone());
+    let lb = row_norm(c.clone() - a.clone());
+    let lc = row_norm(a.clone() - b.clone());
+    let perimeter = la.clone() + lb.clone() + lc.clone();
+    // Eq. 5: the incenter weights each corner by the length of the opposite edge.
+    let means = (a.clone() * la + b.clone() * lb + c.clone() * lc) / perimeter.clone();
+    let ab = b - a.clone();
+    let cross = ab.clone().cross(c - a, 1);
+    let double_area = row_norm(cross.clone());
+    // Eqs. 6–7.
+    let n = cross / double_area.clone();
+    let t1 = normalise(ab);
+    let t2 = n.clone().cross(t1.clone(), 1);
+    // Eq. 8: inradius r = A / s with s the semi-perimeter, so r = 2A / perimeter.
+    let inradius = double_area / perimeter;
+    GaussianGeometry {
+        means,
+        frames: frame(t1, t2, n.clone()),
+        scales: disk_scales(inradius * FACE_SCALE),
+        normals: n,
+    }
+}
+
+/// Area-weighted vertex normals (Eq. 9), [V, 3]: the sum of the adjacent faces' unnormalised
+/// cross products (each 2 A_f n_f), normalised.
+pub fn vertex_normals(vertices: &Tensor<2>, index: &MeshIndex) -> Tensor<2> {
+    let [a, b, c] = index.corner_positions(vertices);
+    let cross = (b - a.clone()).cross(c - a, 1);
+    let mut sum = vertices.zeros_like();
+    for corner in &index.corners {
+        sum = sum.select_assign(0, corner.clone(), cross.clone(), IndexingUpdateOp::Add);
+    }
+    normalise(sum)
+}
+
+/// Vertex Gaussians (Eqs. 9–11) of posed vertices [V, 3].
+pub fn vertex_gaussians(vertices: &Tensor<2>, index: &MeshIndex) -> GaussianGeometry {
+    let n = vertex_normals(vertices, index);
+    // Eq. 10: the reference axis is the coordinate axis least aligned with the normal; the
+    // choice is piecewise constant, so it carries no gradient.
+    let axis = n.clone().detach().abs().argmin(1).reshape([index.num_vertices]);
+    let r: Tensor<2> = axis.one_hot::<2>(3).float().cast(n.dtype());
+    let t1 = normalise(r.cross(n.clone(), 1));
+    let t2 = n.clone().cross(t1.clone(), 1);
+    // Eq. 11: γ times the shortest one-ring edge; padding entries are lifted out of the min.
+    let v = index.num_vertices;
+    let neighbours = vertices.clone().select(0, index.ring.clone()).reshape([v, index.valence, 3]);
+    let offsets = neighbours - vertices.clone().unsqueeze_dim::<3>(1);
+    let lengths = (offsets.square().sum_dim(2) + NORM_EPS).sqrt().reshape([v, index.valence]);
+    let shortest = (lengths + index.ring_pad.clone().cast(n.dtype()) * 1e6).min_dim(1);
+    GaussianGeometry {
+        means: vertices.clone(),
+        frames: frame(t1, t2, n.clone()),
+        scales: disk_scales(shortest * VERTEX_SCALE),
+        normals: n,
+    }
+}

@@ -1,0 +1,59 @@
+//! A small fully connected ReLU network over named parameters (the MLP heads of E_s and of
+//! iHuman's colour encoder).
+
+use burn::tensor::{Device, Tensor, activation::relu};
+
+use crate::params::{Param, tensor_from};
+use mannequin_data::rng::SplitMix64;
+
+#[derive(Clone, Debug)]
+pub struct Mlp {
+    /// Indices of (weight [in, out], bias [1, out]) in the owner's parameter list.
+    pub layers: Vec<(usize, usize)>,
+}
+
+impl Mlp {
+    /// Appends the layers' parameters to `params`: He-uniform weights from `rng`, zero biases,
+    /// and a zero last layer so the network starts as the zero function (no offsets, grey).
+    pub fn new(
+        name: &str,
+        widths: &[usize],
+        lr: f64,
+        rng: &mut SplitMix64,
+        device: &Device,
+        params: &mut Vec<Param>,
+    ) -> Self {
+        let mut layers = Vec::new();
+        for (l, w) in widths.windows(2).enumerate() {
+            let (fan_in, fan_out) = (w[0], w[1]);
+            let last = l + 2 == widths.len();
+            let bound = (6.0 / fan_in as f64).sqrt();
+            let weights: Vec<f32> = (0..fan_in * fan_out)
+                .map(|_| if last { 0.0 } else { rng.range(-bound, bound) as f32 })
+                .collect();
+            params.push(Param::new(
+                &format!("{name}/w{l}"),
+                tensor_from(weights, fan_in, fan_out, device),
+                lr,
+            ));
+            params.push(Param::new(
+                &format!("{name}/b{l}"),
+                tensor_from(vec![0.0; fan_out], 1, fan_out, device),
+                lr,
+            ));
+            layers.push((params.len() - 2, params.len() - 1));
+        }
+        Self { layers }
+    }
+
+    pub fn forward(&self, params: &[Param], x: Tensor<2>) -> Tensor<2> {
+        let mut h = x;
+        for (l, &(w, b)) in self.layers.iter().enumerate() {
+            h = h.matmul(params[w].value.clone()) + params[b].value.clone();
+            if l + 1 < self.layers.len() {
+                h = relu(h);
+            }
+        }
+        h
+    }
+}

@@ -1,0 +1,53 @@
+//! Named learnable tensors with a learning rate each: the unit the optimiser updates and a
+//! checkpoint stores. Keeping them as plain named arrays makes checkpoints ordinary `.npz`
+//! files that numpy can open.
+
+use std::path::Path;
+
+use burn::tensor::{DType, Device, Tensor, TensorData};
+use mannequin_io::{NpyArray, Npz, NpzWriter};
+
+use crate::error::AvatarError;
+
+#[derive(Clone, Debug)]
+pub struct Param {
+    pub name: String,
+    /// A leaf tensor on an autodiff device that requires gradients.
+    pub value: Tensor<2>,
+    pub lr: f64,
+}
+
+/// Host copy of a tensor, for `.npz`.
+pub fn to_npy(t: &Tensor<2>) -> NpyArray {
+    let [r, c] = t.dims();
+    NpyArray::f32(vec![r, c], t.clone().into_data().iter::<f32>().collect())
+}
+
+/// A `[rows, cols]` f32 tensor from host values.
+pub fn tensor_from(values: Vec<f32>, rows: usize, cols: usize, device: &Device) -> Tensor<2> {
+    Tensor::from_data(TensorData::new(values, [rows, cols]), (device, DType::F32))
+}
+
+impl Param {
+    pub fn new(name: &str, value: Tensor<2>, lr: f64) -> Self {
+        Self { name: name.to_string(), value: value.require_grad(), lr }
+    }
+
+    /// Reads `{prefix}{name}` from `npz`, which must have this parameter's shape.
+    pub fn load(&mut self, npz: &Npz, prefix: &str, path: &Path) -> Result<(), AvatarError> {
+        let [r, c] = self.value.dims();
+        let key = format!("{prefix}{}", self.name);
+        let (_, values) = npz.f64_with_shape(&key, &[Some(r), Some(c)])?;
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(AvatarError::file(path, format!("{key}: value {i} is not finite")));
+        }
+        let device = self.value.device();
+        self.value =
+            tensor_from(values.into_iter().map(|v| v as f32).collect(), r, c, &device).require_grad();
+        Ok(())
+    }
+
+    pub fn save(&self, w: &mut NpzWriter, prefix: &str) {
+        w.add(&format!("{prefix}{}", self.name), to_npy(&self.value));
+    }
+}

@@ -1,0 +1,263 @@
+//! Training (Tavatar §4.3, iHuman supplement §1.3): one view per iteration, the losses of
+//! Eq. 16 plus a mask term, Adam, checkpoints that resume bit for bit.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use burn::tensor::{Tensor, TensorData};
+use mannequin_data::rng::SplitMix64;
+use mannequin_io::{NpyArray, Npz, NpzWriter};
+
+use crate::adam::Adam;
+use crate::avatar::Avatar;
+use crate::config::Method;
+use crate::error::AvatarError;
+use crate::losses::{MeshTopology, photometric};
+use crate::views::View;
+
+/// Loss weights and switches.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainOptions {
+    pub iterations: usize,
+    pub seed: u64,
+    /// λ_SSIM of Eqs. 12–13.
+    pub lambda_ssim: f64,
+    /// λ_n (Tavatar 0.05; iHuman 1).
+    pub lambda_normal: f64,
+    /// λ_m for Laplacian + normal consistency (0.01).
+    pub lambda_mesh: f64,
+    /// λ_t of the equilateral regulariser, Eq. 14 (0.01; 0 for the "w/o ER" ablation).
+    pub lambda_equilateral: f64,
+    /// Weight of the L1 between rendered alpha and the mask.
+    pub lambda_mask: f64,
+}
+
+impl TrainOptions {
+    /// The seeds' weights for `method`.
+    pub fn new(method: Method, iterations: usize, seed: u64) -> Self {
+        let ihuman = method == Method::Ihuman;
+        Self {
+            iterations,
+            seed,
+            lambda_ssim: 0.2,
+            lambda_normal: if ihuman { 1.0 } else { 0.05 },
+            lambda_mesh: 0.01,
+            lambda_equilateral: if ihuman { 0.0 } else { 0.01 },
+            lambda_mask: 0.1,
+        }
+    }
+}
+
+/// Wall time of each phase of one iteration, for the benchmark's breakdown.
+#[derive(Debug, Clone, Default)]
+pub struct Timings {
+    pub skinning: Duration,
+    pub derivation: Duration,
+    pub render: Duration,
+    pub losses: Duration,
+    pub backward: Duration,
+    pub optimiser: Duration,
+}
+
+#[derive(Debug, Clone)]
+pub struct StepStats {
+    /// Iterations done, this one included.
+    pub iteration: usize,
+    pub loss: f64,
+    /// PSNR of the colour inside the view's crop.
+    pub psnr: f64,
+    pub timings: Timings,
+}
+
+pub struct Trainer {
+    pub avatar: Avatar,
+    pub options: TrainOptions,
+    pub iteration: usize,
+    adam: Adam,
+    views: Vec<View>,
+    topology: MeshTopology,
+}
+
+/// View order of one epoch: a seeded Fisher–Yates shuffle, a pure function of (seed, epoch) so
+/// a resumed run visits the same views.
+fn epoch_order(seed: u64, epoch: usize, n: usize) -> Vec<usize> {
+    let mut rng = SplitMix64::new(seed ^ (epoch as u64).wrapping_mul(0xD1B5_4A32_D192_ED03));
+    let mut order: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        order.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+    }
+    order
+}
+
+fn image_tensor(
+    values: &[f32],
+    channels: usize,
+    crop: &crate::views::Crop,
+    device: &burn::tensor::Device,
+) -> Tensor<3> {
+    Tensor::from_data(TensorData::new(values.to_vec(), [channels, crop.height, crop.width]), device)
+}
+
+fn crop3(t: Tensor<3>, crop: &crate::views::Crop) -> Tensor<3> {
+    t.narrow(1, crop.y, crop.height).narrow(2, crop.x, crop.width)
+}
+
+impl Trainer {
+    pub fn new(avatar: Avatar, views: Vec<View>, options: TrainOptions) -> Result<Self, AvatarError> {
+        if views.is_empty() {
+            return Err(AvatarError::Invalid("no training views".into()));
+        }
+        let topology =
+            MeshTopology::new(avatar.canonical.num_vertices(), &avatar.canonical.faces, avatar.device())?;
+        let adam = Adam::new(&avatar.params);
+        Ok(Self { avatar, options, iteration: 0, adam, views, topology })
+    }
+
+    pub fn num_views(&self) -> usize {
+        self.views.len()
+    }
+
+    pub fn has_normals(&self) -> bool {
+        self.views.iter().all(|v| v.normals.is_some())
+    }
+
+    /// iHuman's three stages (supplement §1.3) over 20 "epochs" spread across the run: the
+    /// displacement encoder learns fastest in stage 2, joints freeze in stage 3.
+    fn apply_schedule(&mut self) {
+        if self.avatar.config.method != Method::Ihuman {
+            return;
+        }
+        let epoch = 20.0 * self.iteration as f64 / self.options.iterations.max(1) as f64;
+        let stage = if epoch < 4.0 {
+            1
+        } else if epoch < 10.0 {
+            2
+        } else {
+            3
+        };
+        for p in &mut self.avatar.params {
+            p.lr = match p.name.split('/').next().unwrap_or("") {
+                "offsets" => {
+                    if stage == 2 {
+                        8e-4
+                    } else {
+                        1e-4
+                    }
+                }
+                "joints" => {
+                    if stage == 3 {
+                        0.0
+                    } else {
+                        5e-4
+                    }
+                }
+                "colour" => 5e-4,
+                _ => 5e-3,
+            };
+        }
+    }
+
+    /// One iteration on the next view.
+    pub fn step(&mut self) -> Result<StepStats, AvatarError> {
+        self.apply_schedule();
+        let n = self.views.len();
+        let (epoch, k) = (self.iteration / n, self.iteration % n);
+        let view = &self.views[epoch_order(self.options.seed, epoch, n)[k]];
+        let device = self.avatar.device().clone();
+        let o = &self.options;
+        let mut t = Timings::default();
+
+        let clock = Instant::now();
+        let offsets = self.avatar.offsets()?;
+        let personalised = self.avatar.personalised(offsets.clone());
+        let vertices = self.avatar.skin(personalised.clone(), &view.pose, view.transl)?;
+        t.skinning = clock.elapsed();
+        let clock = Instant::now();
+        let gaussians = self.avatar.bind(&vertices);
+        t.derivation = clock.elapsed();
+        let clock = Instant::now();
+        let posed = crate::avatar::Posed { personalised: personalised.clone(), vertices, gaussians };
+        let r = self.avatar.render(&posed, &view.camera)?;
+        t.render = clock.elapsed();
+
+        let clock = Instant::now();
+        let crop = &view.crop;
+        let pred = crop3(r.rgb, crop);
+        let target = image_tensor(&view.rgb, 3, crop, &device);
+        let mse = (pred.clone() - target.clone()).square().mean();
+        let mut loss = photometric(pred, target, o.lambda_ssim)?;
+        if let Some(normals) = &view.normals {
+            let target = image_tensor(normals, 3, crop, &device);
+            loss = loss + photometric(crop3(r.normals, crop), target, o.lambda_ssim)? * o.lambda_normal;
+        }
+        let alpha = r.alpha.narrow(0, crop.y, crop.height).narrow(1, crop.x, crop.width);
+        let mask: Tensor<2> =
+            Tensor::from_data(TensorData::new(view.mask.clone(), [crop.height, crop.width]), &device);
+        loss = loss + (alpha - mask).abs().mean() * o.lambda_mask;
+        // Laplacian smoothness of the offset field and normal consistency of V_s (Eq. 15).
+        let mesh =
+            self.topology.laplacian(offsets)? + self.topology.normal_consistency(personalised.clone())?;
+        loss = loss + mesh * o.lambda_mesh;
+        if o.lambda_equilateral > 0.0 {
+            loss = loss + self.topology.equilateral(personalised)? * o.lambda_equilateral;
+        }
+        let value = loss.clone().into_scalar::<f64>();
+        t.losses = clock.elapsed();
+        if !value.is_finite() {
+            return Err(AvatarError::NonFiniteLoss {
+                iteration: self.iteration + 1,
+                value,
+                checkpoint: String::new(),
+            });
+        }
+        let psnr = -10.0 * mse.into_scalar::<f64>().max(1e-20).log10();
+
+        let clock = Instant::now();
+        let grads = loss.backward();
+        t.backward = clock.elapsed();
+        let clock = Instant::now();
+        self.adam.update(&mut self.avatar.params, &grads);
+        t.optimiser = clock.elapsed();
+        self.iteration += 1;
+        Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
+    }
+
+    /// Writes parameters, optimiser moments and the iteration count atomically.
+    pub fn save_checkpoint(&self, path: &Path) -> Result<(), AvatarError> {
+        let mut w = NpzWriter::new();
+        w.add("iteration", NpyArray::i64(vec![1], vec![self.iteration as i64]));
+        w.add("seed", NpyArray::i64(vec![1], vec![self.options.seed as i64]));
+        for p in &self.avatar.params {
+            p.save(&mut w, "param/");
+        }
+        self.adam.save(&self.avatar.params, &mut w);
+        w.write(path)?;
+        Ok(())
+    }
+
+    /// Continues from a checkpoint written by [`Trainer::save_checkpoint`] for the same avatar
+    /// configuration and seed.
+    pub fn resume(&mut self, path: &Path) -> Result<(), AvatarError> {
+        let npz = Npz::read(path)?;
+        let (_, seed) = npz.f64_with_shape("seed", &[Some(1)])?;
+        if seed[0] as u64 != self.options.seed {
+            return Err(AvatarError::file(
+                path,
+                format!(
+                    "checkpoint was trained with seed {}, this run asks for {}",
+                    seed[0], self.options.seed
+                ),
+            ));
+        }
+        let (_, it) = npz.f64_with_shape("iteration", &[Some(1)])?;
+        self.avatar.load_params(&npz, "param/", path)?;
+        self.adam = Adam::load(&self.avatar.params, &npz, path)?;
+        self.iteration = it[0] as usize;
+        Ok(())
+    }
+}
+
+/// Where a model directory keeps its training checkpoint.
+pub fn checkpoint_path(dir: &Path) -> PathBuf {
+    dir.join("checkpoint.npz")
+}

@@ -1,0 +1,119 @@
+//! Training and test views: a frame's camera and body pose, with its targets cropped to the
+//! subject (masks give the box). Losses only look inside the crop, which keeps SSIM cheap.
+
+use mannequin_data::{Dataset, Split};
+
+use crate::error::AvatarError;
+
+/// Pixels added around the mask's bounding box, so silhouette errors stay inside the crop.
+const CROP_MARGIN: usize = 16;
+/// SSIM's window: crops are at least this large.
+const MIN_CROP: usize = 11;
+
+/// Near and far planes of the splatting camera, in metres.
+const NEAR: f64 = 0.01;
+const FAR: f64 = 100.0;
+
+/// The renderer's camera for a dataset camera (same OpenCV conventions).
+pub fn splat_camera(c: &mannequin_data::Camera) -> mannequin_splat::Camera {
+    mannequin_splat::Camera {
+        width: c.width,
+        height: c.height,
+        intrinsic: c.intrinsic,
+        extrinsic: c.extrinsic,
+        near: NEAR,
+        far: FAR,
+    }
+}
+
+/// A pixel rectangle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Crop {
+    pub x: usize,
+    pub y: usize,
+    pub width: usize,
+    pub height: usize,
+}
+
+#[derive(Debug, Clone)]
+pub struct View {
+    pub frame: usize,
+    pub camera: mannequin_splat::Camera,
+    /// Axis-angle body pose, 72 values (SMPL layout).
+    pub pose: Vec<f32>,
+    pub transl: [f32; 3],
+    pub crop: Crop,
+    /// Target colour over white, [3, h, w] of the crop.
+    pub rgb: Vec<f32>,
+    /// Target camera-space normals (zero on the background), [3, h, w], where the dataset has them.
+    pub normals: Option<Vec<f32>>,
+    /// [h, w] in {0, 1}.
+    pub mask: Vec<f32>,
+}
+
+/// The mask's bounding box grown by the margin, clamped to the image, at least `MIN_CROP` wide.
+fn crop_of(mask: &mannequin_data::Mask) -> Crop {
+    let (w, h) = (mask.width, mask.height);
+    let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
+    for (i, _) in mask.values.iter().enumerate().filter(|(_, m)| **m) {
+        let (x, y) = (i % w, i / w);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+    }
+    if x1 <= x0 {
+        // An empty mask: use the whole image so the avatar learns to vanish there.
+        return Crop { x: 0, y: 0, width: w, height: h };
+    }
+    let grow = |lo: usize, hi: usize, size: usize| {
+        let lo = lo.saturating_sub(CROP_MARGIN);
+        let hi = (hi + CROP_MARGIN).min(size);
+        let hi = hi.max((lo + MIN_CROP).min(size));
+        let lo = lo.min(hi.saturating_sub(MIN_CROP));
+        (lo, hi - lo)
+    };
+    let (x, width) = grow(x0, x1, w);
+    let (y, height) = grow(y0, y1, h);
+    Crop { x, y, width, height }
+}
+
+/// Loads every frame of `split`, calling `progress(done, total)` after each.
+pub fn load_views(
+    dataset: &Dataset,
+    split: &Split,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<View>, AvatarError> {
+    let mut views = Vec::with_capacity(split.frames.len());
+    for (i, &frame) in split.frames.iter().enumerate() {
+        let f = dataset.frame(frame)?;
+        let camera = splat_camera(dataset.camera(frame));
+        if camera.width < MIN_CROP || camera.height < MIN_CROP {
+            return Err(AvatarError::Invalid(format!(
+                "frame {frame}: images of {}×{} are too small to train on (at least {MIN_CROP}×{MIN_CROP})",
+                camera.width, camera.height
+            )));
+        }
+        let crop = crop_of(&f.mask);
+        let (w, n) = (f.image.width, crop.width * crop.height);
+        let mut rgb = vec![0.0f32; 3 * n];
+        let mut mask = vec![0.0f32; n];
+        let mut normals = f.normals.as_ref().map(|_| vec![0.0f32; 3 * n]);
+        for y in 0..crop.height {
+            for x in 0..crop.width {
+                let (p, q) = ((crop.y + y) * w + crop.x + x, y * crop.width + x);
+                let fg = f.mask.values[p];
+                mask[q] = f32::from(u8::from(fg));
+                for c in 0..3 {
+                    rgb[c * n + q] = if fg { f.image.pixels[p][c] } else { 1.0 };
+                }
+                if let (Some(out), Some(map)) = (normals.as_mut(), f.normals.as_ref()) {
+                    for c in 0..3 {
+                        out[c * n + q] = map.normals[p][c];
+                    }
+                }
+            }
+        }
+        let pose = split.poses.pose72(i);
+        views.push(View { frame, camera, pose, transl: split.poses.transl[i], crop, rgb, normals, mask });
+        progress(i + 1, split.frames.len());
+    }
+    Ok(views)
+}

@@ -1,0 +1,200 @@
+//! `mannequin train`: reconstruct an animatable avatar from a dataset (Tavatar by default, or
+//! iHuman), with checkpoints that a re-run of the same command resumes from.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args as ClapArgs;
+use mannequin_avatar::trainer::checkpoint_path;
+use mannequin_avatar::{
+    Avatar, AvatarConfig, AvatarError, Canonical, Method, TrainOptions, Trainer, load_views,
+};
+use mannequin_body::BodyModel;
+use mannequin_data::Dataset;
+
+use crate::progress::{JobTimer, bar};
+
+#[derive(ClapArgs, Clone)]
+pub struct Args {
+    /// Dataset folder (PeopleSnapshot layout, or `mannequin synth` output).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Model folder to write (avatar.json, avatar.npz, checkpoint.npz).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Gaussian binding: tavatar (default) or ihuman.
+    #[arg(long, default_value = "tavatar")]
+    pub method: Method,
+    #[arg(long, default_value_t = 2000)]
+    pub iters: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Body model the dataset's poses drive: default, default-lod1, or an SMPL-family .npz.
+    #[arg(long, default_value = "default")]
+    pub model: String,
+    /// Midpoint subdivisions of the body template (each quadruples the faces).
+    #[arg(long, default_value_t = 0)]
+    pub subdivide: usize,
+    /// Divide the images' resolution by this factor.
+    #[arg(long, default_value_t = 1)]
+    pub downscale: usize,
+    /// Save a checkpoint every this many iterations.
+    #[arg(long, default_value_t = 200)]
+    pub checkpoint_every: usize,
+    /// Ablation: no face Gaussians (vertex scales become learnable).
+    #[arg(long)]
+    pub no_face_gaussians: bool,
+    /// Ablation: no vertex Gaussians.
+    #[arg(long)]
+    pub no_vertex_gaussians: bool,
+    /// Ablation: no equilateral regulariser.
+    #[arg(long)]
+    pub no_equilateral: bool,
+    /// Start over even if the model folder holds a checkpoint.
+    #[arg(long)]
+    pub restart: bool,
+}
+
+impl Args {
+    /// Training arguments with defaults for everything but the paths.
+    pub fn new(data: PathBuf, out: PathBuf) -> Self {
+        Self {
+            data,
+            out,
+            method: Method::Tavatar,
+            iters: 2000,
+            seed: 0,
+            model: "default".into(),
+            subdivide: 0,
+            downscale: 1,
+            checkpoint_every: 200,
+            no_face_gaussians: false,
+            no_vertex_gaussians: false,
+            no_equilateral: false,
+            restart: false,
+        }
+    }
+}
+
+fn avatar_config(args: &Args) -> AvatarConfig {
+    let mut config = AvatarConfig::new(args.method, args.seed);
+    config.subdivisions = args.subdivide;
+    if args.method == Method::Tavatar {
+        config.face_gaussians = !args.no_face_gaussians;
+        config.vertex_gaussians = !args.no_vertex_gaussians;
+    }
+    config
+}
+
+/// The saved configuration of a model folder, if there is one.
+fn saved_config(dir: &Path) -> Result<Option<AvatarConfig>> {
+    let path = dir.join(mannequin_avatar::avatar::CONFIG_FILE);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(Some(serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?))
+}
+
+/// Runs the whole job: checks the dataset, builds or resumes the avatar, trains, saves.
+pub fn run(args: Args) -> Result<()> {
+    let _timer = JobTimer::start("train");
+    let trainer = prepare(&args)?;
+    train(trainer, &args)
+}
+
+/// Everything before the first iteration: every input is checked here.
+pub fn prepare(args: &Args) -> Result<Trainer> {
+    if args.iters == 0 || args.checkpoint_every == 0 {
+        bail!("--iters and --checkpoint-every must be at least 1");
+    }
+    let dataset = Dataset::open(&args.data, args.downscale)?;
+    let split = dataset.split("train")?;
+    let model = BodyModel::from_spec(&args.model, None)?;
+    if model.num_joints() != 24 {
+        bail!(
+            "{}: the dataset's poses are SMPL's 24 joints, but this body model has {}",
+            args.model,
+            model.num_joints()
+        );
+    }
+    let views = {
+        let progress = bar(split.frames.len() as u64, "loading");
+        let views = load_views(&dataset, &split, |done, _| progress.set_position(done as u64))?;
+        progress.finish_and_clear();
+        views
+    };
+    if views.iter().any(|v| v.normals.is_none()) {
+        tracing::warn!("{} has no normal maps: the normal loss is off", args.data.display());
+    }
+    let config = avatar_config(args);
+    let checkpoint = checkpoint_path(&args.out);
+    let resume = !args.restart && checkpoint.exists();
+    if resume {
+        if let Some(saved) = saved_config(&args.out)?
+            && saved != config
+        {
+            bail!(
+                "{} holds a checkpoint of a different avatar configuration; use --restart to start over or another --out",
+                args.out.display()
+            );
+        }
+    }
+    let canonical = Canonical::from_body(&model, &split.poses.betas, args.subdivide)?;
+    let device = burn::tensor::Device::flex().autodiff();
+    let avatar = Avatar::new(config, canonical, &device)?;
+    let mut options = TrainOptions::new(args.method, args.iters, args.seed);
+    if args.no_equilateral {
+        options.lambda_equilateral = 0.0;
+    }
+    let mut trainer = Trainer::new(avatar, views, options)?;
+    if resume {
+        trainer.resume(&checkpoint)?;
+        tracing::info!("resuming from {} at iteration {}", checkpoint.display(), trainer.iteration);
+    } else {
+        // The model folder is usable (loadable) from the start.
+        trainer.avatar.save(&args.out)?;
+    }
+    tracing::info!(
+        "{} Gaussians on {} vertices, {} views, {} iterations",
+        trainer.avatar.num_gaussians(),
+        trainer.avatar.canonical.num_vertices(),
+        trainer.num_views(),
+        args.iters
+    );
+    Ok(trainer)
+}
+
+/// The training loop with its progress bar, checkpoints and final save.
+pub fn train(mut trainer: Trainer, args: &Args) -> Result<()> {
+    let checkpoint = checkpoint_path(&args.out);
+    let progress = bar(args.iters as u64, "training");
+    progress.set_position(trainer.iteration as u64);
+    let mut running_psnr: Option<f64> = None;
+    while trainer.iteration < args.iters {
+        let stats = match trainer.step() {
+            Ok(s) => s,
+            Err(AvatarError::NonFiniteLoss { iteration, value, .. }) => {
+                progress.abandon();
+                let last = if checkpoint.exists() { checkpoint.display().to_string() } else { "none".into() };
+                return Err(AvatarError::NonFiniteLoss { iteration, value, checkpoint: last }.into());
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let p = running_psnr.map_or(stats.psnr, |r| 0.9 * r + 0.1 * stats.psnr);
+        running_psnr = Some(p);
+        progress.set_position(stats.iteration as u64);
+        progress.set_message(format!("loss {:.4} psnr {p:.1}", stats.loss));
+        if stats.iteration % args.checkpoint_every == 0 || stats.iteration == args.iters {
+            trainer.save_checkpoint(&checkpoint)?;
+        }
+    }
+    progress.finish_and_clear();
+    trainer.avatar.save(&args.out)?;
+    tracing::info!(
+        "wrote {} (running PSNR {:.2} dB on training crops)",
+        args.out.display(),
+        running_psnr.unwrap_or(f64::NAN)
+    );
+    Ok(())
+}
