@@ -14,6 +14,7 @@ pub mod losses;
 pub mod mesh_gaussians;
 pub mod mlp;
 pub mod params;
+pub mod predict;
 pub mod trainer;
 pub mod views;
 
@@ -21,5 +22,6 @@ pub use avatar::{Avatar, Posed, Rendered};
 pub use canonical::Canonical;
 pub use config::{AvatarConfig, Method};
 pub use error::AvatarError;
+pub use predict::{Prediction, predict, predict_split};
 pub use trainer::{StepStats, Timings, TrainOptions, Trainer};
 pub use views::{View, load_views, splat_camera};

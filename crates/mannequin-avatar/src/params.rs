@@ -28,9 +28,14 @@ pub fn tensor_from(values: Vec<f32>, rows: usize, cols: usize, device: &Device) 
     Tensor::from_data(TensorData::new(values, [rows, cols]), (device, DType::F32))
 }
 
+/// Marks a leaf as trainable where the device records gradients; inference devices have none.
+pub fn trainable(t: Tensor<2>) -> Tensor<2> {
+    if t.is_autodiff() { t.require_grad() } else { t }
+}
+
 impl Param {
     pub fn new(name: &str, value: Tensor<2>, lr: f64) -> Self {
-        Self { name: name.to_string(), value: value.require_grad(), lr }
+        Self { name: name.to_string(), value: trainable(value), lr }
     }
 
     /// Reads `{prefix}{name}` from `npz`, which must have this parameter's shape.
@@ -42,8 +47,7 @@ impl Param {
             return Err(AvatarError::file(path, format!("{key}: value {i} is not finite")));
         }
         let device = self.value.device();
-        self.value =
-            tensor_from(values.into_iter().map(|v| v as f32).collect(), r, c, &device).require_grad();
+        self.value = trainable(tensor_from(values.into_iter().map(|v| v as f32).collect(), r, c, &device));
         Ok(())
     }
 

@@ -222,6 +222,31 @@ impl Trainer {
         Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
     }
 
+    /// Mean wall time of the splatting backward alone (Gaussians as leaves) on the first view,
+    /// so the benchmark can split the backward pass.
+    pub fn render_backward_time(&self, repeats: usize) -> Result<Duration, AvatarError> {
+        let view = &self.views[0];
+        let posed = self.avatar.pose(&view.pose, view.transl)?;
+        let g = posed.gaussians;
+        let leaf = |t: Tensor<2>| t.detach().require_grad();
+        let gaussians = crate::mesh_gaussians::GaussianGeometry {
+            means: leaf(g.means),
+            frames: g.frames.detach().require_grad(),
+            scales: leaf(g.scales),
+            normals: leaf(g.normals),
+        };
+        let posed = crate::avatar::Posed { gaussians, ..posed };
+        let mut total = Duration::ZERO;
+        for _ in 0..repeats.max(1) {
+            let r = self.avatar.render(&posed, &view.camera)?;
+            let loss = r.rgb.sum() + r.normals.sum() + r.alpha.sum();
+            let clock = Instant::now();
+            let _ = loss.backward();
+            total += clock.elapsed();
+        }
+        Ok(total / repeats.max(1) as u32)
+    }
+
     /// Writes parameters, optimiser moments and the iteration count atomically.
     pub fn save_checkpoint(&self, path: &Path) -> Result<(), AvatarError> {
         let mut w = NpzWriter::new();

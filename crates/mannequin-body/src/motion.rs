@@ -161,7 +161,11 @@ impl Motion {
     /// whole hands, while SMPL-H/X joints 22+ are fingers (or jaw and eyes), so those are set to
     /// the rest rotation rather than copied from a joint that means something else.
     pub fn poses_for(&self, model: &BodyModel) -> Result<Vec<f32>, BodyError> {
-        let target = model.num_joints();
+        self.poses_for_joints(model.num_joints())
+    }
+
+    /// [`Motion::poses_for`] for a body with `target` joints.
+    pub fn poses_for_joints(&self, target: usize) -> Result<Vec<f32>, BodyError> {
         if self.joints == target {
             return Ok(self.poses.clone());
         }

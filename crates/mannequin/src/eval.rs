@@ -1,5 +1,6 @@
 //! `mannequin eval`: compare a folder of predictions with a ground-truth dataset folder, frame by
-//! frame, print a table and optionally write the scores as JSON.
+//! frame, or a trained avatar with a dataset's test sets; print a table and optionally write the
+//! scores as JSON.
 
 use std::path::PathBuf;
 
@@ -7,16 +8,24 @@ use anyhow::Context;
 use mannequin_data::evaluation::{EvalOptions, EvalSummary, FrameScores, evaluate, matching_frames};
 use mannequin_data::metrics::lpips::Lpips;
 
+use crate::eval_avatar::{evaluate_avatar, print_scores};
 use crate::progress::{JobTimer, bar};
 
 #[derive(clap::Args)]
 pub struct Args {
     /// Folder of predictions: images/image_NNNN.png, optionally normals/ and meshes/.
-    #[arg(long)]
-    pred: PathBuf,
+    #[arg(long, required_unless_present = "model", conflicts_with = "model", requires = "gt")]
+    pred: Option<PathBuf>,
     /// Ground-truth dataset folder (PeopleSnapshot layout, see docs/dataset-format.md).
-    #[arg(long)]
-    gt: PathBuf,
+    #[arg(long, requires = "pred")]
+    gt: Option<PathBuf>,
+    /// A trained avatar (model folder of `mannequin train`), scored on --data's test sets.
+    #[arg(long, requires = "data")]
+    model: Option<PathBuf>,
+    /// Dataset folder whose test sets the avatar is scored on (test/novel_view and
+    /// test/novel_pose of `mannequin synth`, or the folder's own test split).
+    #[arg(long, requires = "model")]
+    data: Option<PathBuf>,
     /// Write the scores (means and per frame) to this JSON file.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -106,14 +115,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let _timer = JobTimer::start("eval");
     let background = parse_background(&args.background)?;
     let lpips = args.lpips_weights.as_deref().map(Lpips::load).transpose()?;
-    let frames = matching_frames(&args.pred, &args.gt)?;
-    let progress = bar(frames.len() as u64, "eval");
     let options = EvalOptions { background, lpips, samples: args.samples, seed: args.seed };
-    let summary = evaluate(&args.pred, &args.gt, &options, &|_| progress.inc(1))?;
-    progress.finish_and_clear();
-    print_table(&summary);
+    let text = match (&args.model, &args.data, &args.pred, &args.gt) {
+        (Some(model), Some(data), _, _) => {
+            let scores = evaluate_avatar(model, data, &options)?;
+            print_scores(&scores);
+            serde_json::to_string_pretty(&scores)?
+        }
+        (_, _, Some(pred), Some(gt)) => {
+            let frames = matching_frames(pred, gt)?;
+            let progress = bar(frames.len() as u64, "eval");
+            let summary = evaluate(pred, gt, &options, &|_| progress.inc(1))?;
+            progress.finish_and_clear();
+            print_table(&summary);
+            serde_json::to_string_pretty(&summary)?
+        }
+        _ => anyhow::bail!("give --model and --data, or --pred and --gt"),
+    };
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&summary)?;
         mannequin_io::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
         println!("wrote {}", path.display());

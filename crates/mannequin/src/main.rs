@@ -5,8 +5,10 @@ mod animate;
 mod body;
 mod demo;
 mod eval;
+mod eval_avatar;
 mod motion;
 mod progress;
+mod render;
 mod splat;
 mod synth;
 mod train;
@@ -41,6 +43,8 @@ enum Command {
     Synth(synth::Args),
     /// Render a 3D Gaussian splatting .ply through a camera, or summarise one.
     Splat(splat::Args),
+    /// Render a trained avatar at a dataset frame or a motion frame: colour, normals, alpha or depth.
+    Render(render::Args),
     /// Reconstruct an animatable avatar from a dataset (Tavatar or iHuman binding).
     Train(train::Args),
 }
@@ -57,6 +61,7 @@ fn main() -> std::process::ExitCode {
         Command::Synth(args) => synth::run(args),
         Command::Splat(args) => splat::run(args),
         Command::Train(args) => train::run(args),
+        Command::Render(args) => render::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

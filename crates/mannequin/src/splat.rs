@@ -61,7 +61,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 /// A camera JSON file, with its background colour.
-fn read_camera(path: &Path) -> anyhow::Result<(Camera, Vec<f64>)> {
+pub fn read_camera(path: &Path) -> anyhow::Result<(Camera, Vec<f64>)> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
     let v: Value =
         serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;

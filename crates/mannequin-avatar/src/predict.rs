@@ -1,0 +1,97 @@
+//! Inference: render an avatar at a pose through a camera into host images (colour over white,
+//! normal map, mask, depth) and its posed mesh, and write whole test sets in the dataset layout
+//! so `mannequin_data::evaluation` can score them.
+
+use std::path::Path;
+
+use burn::tensor::Tensor;
+use mannequin_data::{Dataset, DatasetWriter, DepthMap, Frame, Image, Mask, NormalMap};
+use mannequin_mesh::TriMesh;
+
+use crate::avatar::Avatar;
+use crate::error::AvatarError;
+use crate::views::splat_camera;
+
+/// A pixel belongs to the avatar where its alpha reaches this.
+const FOREGROUND_ALPHA: f32 = 0.5;
+
+pub struct Prediction {
+    pub image: Image,
+    pub mask: Mask,
+    pub normals: NormalMap,
+    pub depth: DepthMap,
+    /// The posed personalised mesh, world coordinates.
+    pub mesh: TriMesh,
+}
+
+fn host(t: Tensor<2>) -> Vec<f32> {
+    t.into_data().iter::<f32>().collect()
+}
+
+fn host3(t: Tensor<3>) -> Vec<f32> {
+    t.into_data().iter::<f32>().collect()
+}
+
+/// Renders `avatar` at `pose`/`transl` through `camera`.
+pub fn predict(
+    avatar: &Avatar,
+    camera: &mannequin_splat::Camera,
+    pose: &[f32],
+    transl: [f32; 3],
+) -> Result<Prediction, AvatarError> {
+    let posed = avatar.pose(pose, transl)?;
+    let r = avatar.render(&posed, camera)?;
+    let (w, h) = (camera.width, camera.height);
+    let n = w * h;
+    let rgb = host3(r.rgb);
+    let nrm = host3(r.normals);
+    let alpha = host(r.alpha);
+    let depth = host(r.depth);
+    let fg: Vec<bool> = alpha.iter().map(|&a| a >= FOREGROUND_ALPHA).collect();
+    let image =
+        Image { width: w, height: h, pixels: (0..n).map(|p| [rgb[p], rgb[n + p], rgb[2 * n + p]]).collect() };
+    let normals = (0..n)
+        .map(|p| {
+            let v = [nrm[p], nrm[n + p], nrm[2 * n + p]];
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if fg[p] && len > 0.0 { v.map(|c| c / len) } else { [0.0; 3] }
+        })
+        .collect();
+    // The renderer's depth is Σ wᵢ zᵢ; over alpha it is the expected depth of the surface.
+    let depth = (0..n).map(|p| if fg[p] { depth[p] / alpha[p] } else { 0.0 }).collect();
+    let positions = host(posed.vertices).chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect();
+    Ok(Prediction {
+        image,
+        mask: Mask { width: w, height: h, values: fg },
+        normals: NormalMap { width: w, height: h, normals },
+        depth: DepthMap { width: w, height: h, depth },
+        mesh: TriMesh::new(positions, avatar.canonical.faces.clone()),
+    })
+}
+
+/// Renders every frame of `split` of `dataset` into `out` (images, masks, normals, depth,
+/// meshes, in the dataset layout), calling `on_frame` after each.
+pub fn predict_split(
+    avatar: &Avatar,
+    dataset: &Dataset,
+    split: &str,
+    out: &Path,
+    on_frame: &dyn Fn(),
+) -> Result<(), AvatarError> {
+    let split = dataset.split(split)?;
+    let writer = DatasetWriter::new(out);
+    for (i, &frame) in split.frames.iter().enumerate() {
+        let camera = splat_camera(dataset.camera(frame));
+        let p = predict(avatar, &camera, &split.poses.pose72(i), split.poses.transl[i])?;
+        writer.write_frame(&Frame {
+            index: frame,
+            image: p.image,
+            mask: p.mask,
+            normals: Some(p.normals),
+            depth: Some(p.depth),
+        })?;
+        writer.write_mesh(frame, &p.mesh)?;
+        on_frame();
+    }
+    Ok(())
+}
