@@ -266,3 +266,54 @@ fn an_empty_scene_renders_the_background_on_every_backend() {
         assert_eq!(means.grad(&grads).map(|g| g.dims()), Some([0, 3]), "{name}");
     }
 }
+
+/// NaN or infinite Gaussians are skipped and counted on every backend: the image is the one
+/// without them (rendered by the CPU renderer with their opacity set to 0), and their gradients
+/// are zero.
+#[test]
+fn non_finite_gaussians_are_skipped_and_counted_on_every_backend() {
+    let scene = Scene::random(30, 61, 0, 3);
+    let bad_ones = [2, 4, 9, 17, 23];
+    let mut hidden = scene.clone();
+    for &i in &bad_ones {
+        hidden.opacities[i] = 0.0;
+    }
+    let cam = camera(40, 32);
+    let opts = RenderOptions::default();
+    let h = hidden.cast::<f32>();
+    let want = render(&h.gaussians(RotForm::Quaternion, ColorForm::Features(3)), &cam, &opts).unwrap();
+    let mut s = scene.cast::<f32>();
+    s.means[3 * 2 + 1] = f32::NAN;
+    s.scales[3 * 4] = f32::INFINITY;
+    s.opacities[9] = f32::NAN;
+    s.features[3 * 17 + 2] = f32::NEG_INFINITY;
+    s.quats[4 * 23] = f32::INFINITY;
+    let n = scene.len();
+    for (name, device) in devices() {
+        let device = device.autodiff();
+        let means = tensor(&s.means, [n, 3], &device).require_grad();
+        let render_with = |features: &[f32]| {
+            splat_render(
+                means.clone(),
+                RotationTensor::Quaternions(tensor(&s.quats, [n, 4], &device)),
+                tensor(&s.scales, [n, 3], &device),
+                tensor(&s.opacities, [n], &device),
+                ColorTensor::Features(tensor(&features[..3 * n], [n, 3], &device)),
+                &cam,
+                &opts,
+            )
+            .unwrap()
+        };
+        let out = render_with(&s.features);
+        assert_eq!(values(out.skipped.clone()), [5.0], "{name}: skipped");
+        close(&format!("{name} image"), &values(out.image.clone()), &want.image, 1e-5);
+        let grads = out.image.sum().backward();
+        let d = values(means.grad(&grads).expect("gradient"));
+        assert!(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0), "{name}: {d:?}");
+        for &i in &bad_ones {
+            assert_eq!(d[3 * i..3 * i + 3], [0.0; 3], "{name}: Gaussian {i}");
+        }
+        let clean = render_with(&h.features);
+        assert_eq!(values(clean.skipped), [4.0], "{name}: skipped with finite features");
+    }
+}

@@ -1,7 +1,8 @@
-//! The op on the CubeCL backends (wgpu, CUDA, …). Projection, compositing, the compositing
-//! replay and the per-Gaussian backward run as CubeCL kernels on the device. Binning (the depth
-//! sort and tile lists) runs on the host with the CPU code: the forward reads back the packed
-//! screen-space rows and uploads the lists. The backward reads nothing back.
+//! The op on the CubeCL backends (wgpu, CUDA, …). Everything runs as CubeCL kernels on the
+//! device: projection, tile binning (`binning.rs`), compositing, the compositing replay and the
+//! per-Gaussian backward. The forward reads back one word (the number of tile entries, to size
+//! the lists) and the backward the header of the saved state; no per-Gaussian data leaves the
+//! device.
 
 use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
@@ -11,33 +12,37 @@ use burn::tensor::{FloatDType, TensorData, read_sync};
 use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
 use burn_cubecl::kernel::into_contiguous;
 
+use super::binning::bin;
 use super::kernels::{LayoutLaunch, composite_backward, composite_forward};
 use super::project_kernels::{camera_words, project_backward, project_forward};
-use super::saved::{WordLayout, encode_lists};
+use super::saved::{HEADER, WordLayout, size_words};
 use super::{SplatBackend, SplatConfig};
 use crate::camera::CameraParams;
 use crate::composite::field;
 use crate::composite_vjp::SCREEN_GRADS;
-use crate::project::Projection;
-use crate::tiles::bin;
 
-/// Units per cube for the per-Gaussian kernels.
+/// Units per cube for the per-Gaussian (and per-chunk) kernels.
 const GROUP: u32 = 256;
 
-fn read(t: FloatTensor<CubeBackend>) -> Vec<f32> {
+pub(super) fn read(t: FloatTensor<CubeBackend>) -> Vec<f32> {
     read_sync(CubeBackend::float_into_data(t))
         .expect("reading a splat tensor from the device")
         .try_to_vec::<f32>()
         .expect("f32 tensor")
 }
 
-fn upload(v: Vec<f32>, like: &CubeTensor) -> CubeTensor {
+pub(super) fn upload(v: Vec<f32>, like: &CubeTensor) -> CubeTensor {
     let n = v.len();
     CubeBackend::float_from_data(TensorData::new(v, vec![n]), &like.device())
 }
 
-fn zeros(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
+pub(super) fn zeros(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
     CubeBackend::float_zeros(shape.into(), &like.device(), FloatDType::F32)
+}
+
+/// A buffer of `len` 32-bit words that a kernel fills (kernels read `f32` buffers as `u32` too).
+pub(super) fn buffer(len: usize, like: &CubeTensor) -> CubeTensor {
+    CubeBackend::float_empty(vec![len].into(), &like.device(), FloatDType::F32)
 }
 
 /// Alpha threshold, cap, transmittance floor and background, as the compositing kernels read them.
@@ -52,7 +57,7 @@ fn camera(config: &SplatConfig, like: &CubeTensor) -> CubeTensor {
     upload(camera_words(&CameraParams::new(&config.camera), config.options.alpha_threshold), like)
 }
 
-fn u32_of(v: usize) -> u32 {
+pub(super) fn u32_of(v: usize) -> u32 {
     u32::try_from(v).expect("splat buffers index within u32")
 }
 
@@ -74,23 +79,55 @@ fn tile_grid(config: &SplatConfig) -> CubeCount {
     CubeCount::Static(tx as u32, ty as u32, 1)
 }
 
-fn gaussian_grid(n: usize) -> CubeCount {
-    CubeCount::Static(u32_of(n).div_ceil(GROUP), 1, 1)
+/// Enough cubes of [`units_dim`] for `n` units.
+pub(super) fn units_grid(n: usize) -> CubeCount {
+    CubeCount::Static(u32_of(n).div_ceil(GROUP).max(1), 1, 1)
 }
 
-/// The screen-space rows read back from the device, in the form the binning takes.
-fn projection_of(rows: &[f32], radii: &[f32], stride: usize) -> (Projection<f32>, Vec<f32>) {
-    let n = radii.len() / 2;
-    let at = |i: usize, f: usize| rows[i * stride + f];
-    let projection = Projection {
-        means2d: (0..n).flat_map(|i| [at(i, field::MX), at(i, field::MY)]).collect(),
-        conics: (0..n).flat_map(|i| [at(i, field::A), at(i, field::B), at(i, field::C)]).collect(),
-        depths: (0..n).map(|i| at(i, field::DEPTH)).collect(),
-        radii: radii.iter().map(|&r| r.min(u32::MAX as f32) as u32).collect(),
-        colors: Vec::new(),
-        skipped: 0,
-    };
-    (projection, (0..n).map(|i| at(i, field::OPACITY)).collect())
+pub(super) fn units_dim() -> CubeDim {
+    CubeDim::new_1d(GROUP)
+}
+
+/// The projected Gaussians: packed rows (index order, `stride` words each), radii (0: not drawn;
+/// one per axis) and the count of Gaussians skipped for a NaN or infinite parameter (one `f32`).
+pub(super) struct Projected {
+    pub rows: CubeTensor,
+    pub radii: CubeTensor,
+    pub skipped: CubeTensor,
+    pub stride: usize,
+}
+
+pub(super) fn project(inputs: [CubeTensor; 5], config: &SplatConfig) -> Projected {
+    let [means, rotations, scales, opacities, colors] = inputs;
+    let like = means.clone();
+    let n = means.shape()[0];
+    let stride = field::COLOR + config.channels();
+    let rows = zeros(vec![n * stride], &like);
+    let radii = zeros(vec![2 * n], &like);
+    let skipped = zeros(vec![1], &like);
+    if n > 0 {
+        project_forward::launch(
+            &like.client,
+            units_grid(n),
+            units_dim(),
+            into_contiguous(means).into_buffer_arg(),
+            into_contiguous(rotations).into_buffer_arg(),
+            into_contiguous(scales).into_buffer_arg(),
+            into_contiguous(opacities).into_buffer_arg(),
+            into_contiguous(colors).into_buffer_arg(),
+            camera(config, &like).into_buffer_arg(),
+            rows.clone().into_buffer_arg(),
+            radii.clone().into_buffer_arg(),
+            skipped.clone().into_buffer_arg(),
+            u32_of(n),
+            config.matrices,
+            config.sh_degree.unwrap_or(0) as u32,
+            config.sh_degree.is_some(),
+            config.color_len,
+            stride,
+        );
+    }
+    Projected { rows, radii, skipped, stride }
 }
 
 impl SplatBackend for CubeBackend {
@@ -105,39 +142,17 @@ impl SplatBackend for CubeBackend {
         let like = means.clone();
         let n = means.shape()[0];
         let (c, h, w) = (config.channels(), config.camera.height, config.camera.width);
-        let stride = field::COLOR + c;
-        let rows = zeros(vec![n * stride], &like);
-        let radii = zeros(vec![2 * n], &like);
-        if n > 0 {
-            project_forward::launch(
-                &like.client,
-                gaussian_grid(n),
-                CubeDim::new_1d(GROUP),
-                into_contiguous(means).into_buffer_arg(),
-                into_contiguous(rotations).into_buffer_arg(),
-                into_contiguous(scales).into_buffer_arg(),
-                into_contiguous(opacities).into_buffer_arg(),
-                into_contiguous(colors).into_buffer_arg(),
-                camera(&config, &like).into_buffer_arg(),
-                rows.clone().into_buffer_arg(),
-                radii.clone().into_buffer_arg(),
-                u32_of(n),
-                config.matrices,
-                config.sh_degree.unwrap_or(0) as u32,
-                config.sh_degree.is_some(),
-                config.color_len,
-                stride,
-            );
-        }
-        // Binning on the host; the lists name Gaussians by index (the rows stay in index order).
-        let (projection, opacity) = projection_of(&read(rows.clone()), &read(radii), stride);
-        let tiles = bin(&projection, &opacity, config.options.alpha_threshold, w, h);
-        let ids: Vec<u32> = tiles.ids.iter().map(|&r| tiles.order[r as usize]).collect();
-        let header =
-            [stride, tiles.tiles_x, tiles.tiles_y, 0, tiles.offsets.len(), ids.len(), w * h, n * stride];
-        let lists = encode_lists(header, &[], &tiles.offsets, &ids);
-        let layout = WordLayout::parse(&lists).expect("a header just written");
-        let words = Self::float_cat(vec![upload(lists, &like), rows], 0);
+        let p = project([means, rotations, scales, opacities, colors], &config);
+        let tiles = bin(&p.rows, &p.radii, n, p.stride, &config);
+        let (tiles_x, tiles_y) = config.camera.tiles();
+        let n_offsets = tiles_x * tiles_y + 1;
+        let sizes = [p.stride, tiles_x, tiles_y, 0, n_offsets, tiles.n_ids, w * h, n * p.stride];
+        let head = size_words(sizes);
+        let layout = WordLayout::parse(&head).expect("sizes just written");
+        let mut parts = vec![upload(head, &like), p.skipped, tiles.offsets];
+        parts.extend(tiles.ids);
+        parts.push(p.rows);
+        let words = Self::float_cat(parts, 0);
         let rendered = zeros(vec![c + 2, h, w], &like);
         let last = zeros(vec![w * h], &like);
         composite_forward::launch(
@@ -170,7 +185,7 @@ impl SplatBackend for CubeBackend {
         let shape = |t: &CubeTensor| t.shape().to_vec();
         let d = [&means, &rotations, &scales, &opacities, &colors].map(|t| zeros(shape(t), &like));
         let c = config.channels();
-        let head = read(Self::float_slice(saved.clone(), &[(0..8).into()]));
+        let head = read(Self::float_slice(saved.clone(), &[(0..HEADER).into()]));
         let layout = WordLayout::parse(&head).expect("the state splat_forward saved");
         let sums = zeros(vec![n.max(1) * (SCREEN_GRADS + c)], &like);
         composite_backward::launch(
@@ -188,8 +203,8 @@ impl SplatBackend for CubeBackend {
         if n > 0 {
             project_backward::launch(
                 &like.client,
-                gaussian_grid(n),
-                CubeDim::new_1d(GROUP),
+                units_grid(n),
+                units_dim(),
                 into_contiguous(means).into_buffer_arg(),
                 into_contiguous(rotations).into_buffer_arg(),
                 into_contiguous(scales).into_buffer_arg(),
@@ -210,5 +225,31 @@ impl SplatBackend for CubeBackend {
         }
         let [a, b, s, o, col] = d;
         (a, b, s, o, col)
+    }
+}
+
+/// Device buffers for the kernels' unit tests, on wgpu (lavapipe on machines without a GPU).
+#[cfg(test)]
+pub(super) mod testing {
+    use burn::backend::ops::FloatTensorOps;
+    use burn::backend::wgpu::{CubeBackend, CubeTensor, WgpuDevice};
+    use burn::tensor::TensorData;
+    use burn_cubecl::CubeDevice;
+
+    pub fn device() -> CubeDevice {
+        CubeDevice::Wgpu(WgpuDevice::default())
+    }
+
+    pub fn floats(v: &[f32], shape: Vec<usize>, device: &CubeDevice) -> CubeTensor {
+        CubeBackend::float_from_data(TensorData::new(v.to_vec(), shape), device)
+    }
+
+    /// `u32`s travel as the bit patterns of `f32`s, as the kernels read them.
+    pub fn words(v: &[u32], device: &CubeDevice) -> CubeTensor {
+        floats(&v.iter().map(|&x| f32::from_bits(x)).collect::<Vec<_>>(), vec![v.len()], device)
+    }
+
+    pub fn read_words(t: CubeTensor, len: usize) -> Vec<u32> {
+        super::read(t).iter().take(len).map(|v| v.to_bits()).collect()
     }
 }

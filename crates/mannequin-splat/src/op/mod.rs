@@ -22,12 +22,15 @@
 //! ```
 
 mod autodiff;
+mod binning;
 mod cube;
 mod flex;
 mod host;
 mod kernels;
 mod project_kernels;
+mod radix_sort;
 mod saved;
+mod scan;
 
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
@@ -52,7 +55,7 @@ pub enum ColorTensor {
     Features(Tensor<2>),
 }
 
-/// What [`splat_render`] returns; all three are differentiable.
+/// What [`splat_render`] returns; the three images are differentiable.
 pub struct SplatImages {
     /// `[C, H, W]` colour or features over the background.
     pub image: Tensor<3>,
@@ -60,6 +63,9 @@ pub struct SplatImages {
     pub alpha: Tensor<2>,
     /// `[H, W]` expected camera-space depth.
     pub depth: Tensor<2>,
+    /// `[1]`: how many Gaussians were skipped for a NaN or infinite parameter (a whole number,
+    /// exact up to 2²⁴). It stays on the device until read, so it costs nothing unless asked for.
+    pub skipped: Tensor<1>,
 }
 
 /// How the op reads its flat inputs: the camera, the rules, and the input forms. Host data, not
@@ -137,8 +143,9 @@ fn shape_error(field: &'static str, expected: usize, found: usize) -> SplatError
 /// on Flex and on the CubeCL backends; the device is the one the tensors live on.
 ///
 /// Shapes, camera and options are checked here. Per-Gaussian values are not (that would need a
-/// read-back from the device): NaN or infinite Gaussians are skipped, and others are rendered
-/// as the formulas say, so keep scales positive and opacities in `[0, 1]`.
+/// read-back from the device): NaN or infinite Gaussians are skipped and counted
+/// ([`SplatImages::skipped`]), and others are rendered as the formulas say, so keep scales
+/// positive and opacities in `[0, 1]`.
 pub fn splat_render(
     means: Tensor<2>,
     rotations: RotationTensor,
@@ -201,7 +208,7 @@ pub fn splat_render(
     camera.validate()?;
     config.options_checked()?;
     let (h, w, ch) = (camera.height, camera.width, config.channels());
-    let (rendered, _saved) = <Dispatch as SplatBackend>::splat_forward(
+    let (rendered, saved) = <Dispatch as SplatBackend>::splat_forward(
         means.into_dispatch(),
         rotations.into_dispatch(),
         scales.into_dispatch(),
@@ -214,6 +221,7 @@ pub fn splat_render(
         image: rendered.clone().narrow(0, 0, ch),
         alpha: rendered.clone().narrow(0, ch, 1).reshape([h, w]),
         depth: rendered.narrow(0, ch + 1, 1).reshape([h, w]),
+        skipped: Tensor::<1>::from_dispatch(saved).narrow(0, saved::SKIPPED, 1),
     })
 }
 

@@ -51,14 +51,18 @@ const T2: usize = 29;
 const COV: usize = 35;
 const STATE: usize = 38;
 
-/// `v·0` is 0 for finite `v`, NaN otherwise.
+/// Whether the `len` values from `start` are all finite (exponent bits not all set). This is
+/// integer logic on purpose: shader compilers may assume floats are never NaN, so a float test
+/// such as `v·0 != 0` can be folded away (on lavapipe it was).
 #[cube]
-fn finite_sum(data: &[f32], start: usize, len: usize) -> f32 {
-    let mut acc = 0.0f32;
+fn all_finite(data: &[f32], start: usize, len: usize) -> bool {
+    let mut finite = true;
     for k in 0..len {
-        acc += data[start + k] * 0.0f32;
+        if u32::reinterpret(data[start + k]) & 0x7F80_0000u32 == 0x7F80_0000u32 {
+            finite = false;
+        }
     }
-    acc
+    finite
 }
 
 /// Fills `s` with the camera-space mean, rotation, `Mc = W R diag(s)`, the clamped `x/z, y/z`
@@ -214,7 +218,8 @@ fn sh_basis_vjp(x: f32, y: f32, z: f32, g: &Array<f32>, out: &mut Array<f32>, #[
 }
 
 /// Projects every Gaussian: a packed row (mean, conic, opacity, depth, …, colour; see
-/// `composite::field`) and its radii in pixels (0: culled or skipped).
+/// `composite::field`) and its radii in pixels (0: culled or skipped). Gaussians with a NaN or
+/// infinite parameter are skipped and counted in `skipped[0]`.
 #[cube(launch)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_forward(
@@ -226,6 +231,7 @@ pub(crate) fn project_forward(
     cam: &[f32],
     rows: &mut [f32],
     radii: &mut [f32],
+    skipped: &mut [Atomic<f32>],
     n: u32,
     #[comptime] matrices: bool,
     #[comptime] sh_degree: u32,
@@ -240,12 +246,13 @@ pub(crate) fn project_forward(
     radii[2 * i] = 0.0f32;
     radii[2 * i + 1] = 0.0f32;
     let rot_len = comptime!(if matrices { 9usize } else { 4usize });
-    let check = finite_sum(means, 3 * i, 3)
-        + finite_sum(rots, rot_len * i, rot_len)
-        + finite_sum(scales, 3 * i, 3)
-        + opacities[i] * 0.0f32
-        + finite_sum(colors, color_len * i, color_len);
-    if check != 0.0f32 {
+    let finite = all_finite(means, 3 * i, 3)
+        && all_finite(rots, rot_len * i, rot_len)
+        && all_finite(scales, 3 * i, 3)
+        && all_finite(opacities, i, 1)
+        && all_finite(colors, color_len * i, color_len);
+    if !finite {
+        skipped[0].fetch_add(1.0f32);
         terminate!();
     }
     let mut s = Array::<f32>::new(STATE);

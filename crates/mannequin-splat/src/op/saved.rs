@@ -6,7 +6,10 @@ use crate::composite::Packed;
 use crate::render::{Prepared, RenderOutput, Saved};
 use crate::tiles::Tiles;
 
-const HEADER: usize = 8;
+/// Eight sizes (as bit patterns), then the count of Gaussians skipped for a NaN or infinite
+/// parameter, as an `f32` value (exact up to 2²⁴) so that callers can read it as a number.
+pub(crate) const HEADER: usize = 9;
+pub(crate) const SKIPPED: usize = 8;
 
 fn bits(v: usize) -> f32 {
     f32::from_bits(v as u32)
@@ -28,9 +31,9 @@ pub(crate) struct WordLayout {
 }
 
 impl WordLayout {
-    /// Reads the header.
+    /// Reads the sizes at the start of the header.
     pub fn parse(words: &[f32]) -> Option<Self> {
-        let h: Vec<usize> = words.get(..HEADER)?.iter().map(|&v| int(v)).collect();
+        let h: Vec<usize> = words.get(..SKIPPED)?.iter().map(|&v| int(v)).collect();
         let [stride, tiles_x, _tiles_y, n_order, n_offsets, n_ids, _n_last, n_rows] = h[..] else {
             return None;
         };
@@ -41,22 +44,18 @@ impl WordLayout {
     }
 }
 
-/// The header and tile lists, followed by `rows` words of packed Gaussians and `last` words of
-/// replay lengths that the caller appends.
-pub(crate) fn encode_lists(header: [usize; 8], order: &[u32], offsets: &[usize], ids: &[u32]) -> Vec<f32> {
-    let mut w = Vec::with_capacity(HEADER + order.len() + offsets.len() + ids.len());
-    w.extend(header.map(bits));
-    w.extend(order.iter().map(|&v| bits(v as usize)));
-    w.extend(offsets.iter().map(|&v| bits(v)));
-    w.extend(ids.iter().map(|&v| bits(v as usize)));
-    w
+/// The sizes in the header: stride, tiles across and down, then the lengths of the depth order,
+/// the tile offsets, the tile lists, the replay lengths and the packed rows. They are followed by
+/// the skipped count (the caller's), then the parts in that order, the replay lengths last.
+pub(crate) fn size_words(sizes: [usize; 8]) -> Vec<f32> {
+    sizes.map(bits).to_vec()
 }
 
 /// Flattens the binning and packing (everything but the per-pixel replay lengths, which come
 /// last and are `npx` words long).
-pub(crate) fn encode_prepared(prep: &Prepared<f32>, npx: usize) -> Vec<f32> {
+fn encode_prepared(prep: &Prepared<f32>, npx: usize, skipped: usize) -> Vec<f32> {
     let Prepared { packed, tiles } = prep;
-    let header = [
+    let sizes = [
         packed.stride,
         tiles.tiles_x,
         tiles.tiles_y,
@@ -66,14 +65,18 @@ pub(crate) fn encode_prepared(prep: &Prepared<f32>, npx: usize) -> Vec<f32> {
         npx,
         packed.rows.len(),
     ];
-    let mut w = encode_lists(header, &tiles.order, &tiles.offsets, &tiles.ids);
+    let mut w = size_words(sizes);
+    w.push(skipped as f32);
+    w.extend(tiles.order.iter().map(|&v| bits(v as usize)));
+    w.extend(tiles.offsets.iter().map(|&v| bits(v)));
+    w.extend(tiles.ids.iter().map(|&v| bits(v as usize)));
     w.extend_from_slice(&packed.rows);
     w
 }
 
 /// Flattens what [`crate::backward`] needs besides the images.
 pub(crate) fn encode(out: &RenderOutput<f32>) -> Vec<f32> {
-    let mut w = encode_prepared(&out.saved.prep, out.saved.last.len());
+    let mut w = encode_prepared(&out.saved.prep, out.saved.last.len(), out.skipped);
     w.extend(out.saved.last.iter().map(|&v| bits(v as usize)));
     w
 }
@@ -88,10 +91,11 @@ pub(crate) fn decode(
 ) -> Option<RenderOutput<f32>> {
     let npx = width * height;
     let channels = (rendered.len() / npx.max(1)).checked_sub(2)?;
-    let header: Vec<usize> = words.get(..HEADER)?.iter().map(|&v| int(v)).collect();
+    let header: Vec<usize> = words.get(..SKIPPED)?.iter().map(|&v| int(v)).collect();
     let [stride, tiles_x, tiles_y, n_order, n_offsets, n_ids, n_last, n_rows] = header[..] else {
         return None;
     };
+    let skipped = *words.get(SKIPPED)? as usize;
     let mut at = HEADER;
     let mut take = |n: usize| -> Option<&[f32]> {
         let s = words.get(at..at + n)?;
@@ -115,7 +119,7 @@ pub(crate) fn decode(
         alpha: rendered[channels * npx..(channels + 1) * npx].to_vec(),
         depth: rendered[(channels + 1) * npx..].to_vec(),
         count: None,
-        skipped: 0,
+        skipped,
         saved: Saved { prep: Prepared { packed: Packed { stride, rows }, tiles }, last },
     })
 }
