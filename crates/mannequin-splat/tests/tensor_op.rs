@@ -6,7 +6,8 @@ mod common;
 use burn::tensor::{Device, DeviceKind, Tensor, TensorData};
 use common::{ColorForm, RotForm, Scene, camera};
 use mannequin_splat::{
-    ColorTensor, OutputGrads, RenderOptions, RotationTensor, SplatError, backward, render, splat_render,
+    Camera, ColorTensor, OutputGrads, RenderOptions, RotationTensor, SplatError, backward, render,
+    splat_render,
 };
 
 fn devices() -> Vec<(&'static str, Device)> {
@@ -39,11 +40,10 @@ enum Leaf {
 /// gradients with the CPU renderer on the same inputs.
 fn check(rot: RotForm, col: ColorForm, seed: u64) {
     let scene = Scene::random(40, seed, if let ColorForm::Sh(d) = col { d } else { 0 }, 4);
-    check_scene(&scene, rot, col, seed);
+    check_scene(&scene, rot, col, seed, camera(32, 24));
 }
 
-fn check_scene(scene: &Scene, rot: RotForm, col: ColorForm, seed: u64) {
-    let cam = camera(32, 24);
+fn check_scene(scene: &Scene, rot: RotForm, col: ColorForm, seed: u64, cam: Camera) {
     let opts = RenderOptions {
         background: vec![0.3; if let ColorForm::Features(c) = col { c } else { 3 }],
         ..Default::default()
@@ -159,7 +159,18 @@ fn saturated_pixels_match_the_cpu_renderer_on_every_backend() {
     );
     let opaque = cpu.unwrap().alpha.iter().filter(|&&a| a > 0.999).count();
     assert!(opaque > 20, "only {opaque} pixels reach the transmittance floor");
-    check_scene(&scene, RotForm::Quaternion, ColorForm::Sh(1), 33);
+    check_scene(&scene, RotForm::Quaternion, ColorForm::Sh(1), 33, camera(32, 24));
+}
+
+/// Many tiles, with splats that span several of them and lists of a few hundred Gaussians:
+/// the device binning feeds the compositor the lists the CPU renderer uses.
+#[test]
+fn a_many_tile_image_matches_the_cpu_renderer_on_every_backend() {
+    let mut scene = Scene::random(400, 36, 1, 3);
+    for v in scene.scales.iter_mut().step_by(7) {
+        *v *= 4.0;
+    }
+    check_scene(&scene, RotForm::Quaternion, ColorForm::Sh(1), 36, camera(112, 80));
 }
 
 /// Gradients reach tensors computed by Burn's own ops upstream, and a few steps of gradient

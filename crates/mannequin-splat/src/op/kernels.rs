@@ -2,8 +2,8 @@
 //! for the backward pass. One cube is one 16×16 tile and one unit is one pixel, which walks its
 //! tile's depth-ordered list exactly as the CPU compositor does (same rule, same state).
 //!
-//! Everything the CPU binning produced lives in one `f32` buffer (`words`, see `saved.rs`):
-//! integers are stored as bit patterns and read back with `u32::reinterpret`.
+//! The tile lists (from `binning.rs`) and the packed rows live in one `f32` buffer (`words`, see
+//! `saved.rs`): integers are stored as bit patterns and read back with `u32::reinterpret`.
 //!
 //! Each unit loops over its tile's list. Mesa's lavapipe silently stops any shader loop after
 //! 65,535 iterations, so on lavapipe a tile must list fewer Gaussians than that (the tests do);
