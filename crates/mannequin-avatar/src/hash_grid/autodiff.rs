@@ -1,5 +1,6 @@
 //! The op under autodiff. The encoding is linear in the table, so the backward step needs none
-//! of the table's values: its state is the lookup (constant tensors) and the table's row count.
+//! of the table's values: its state is the lookup's grouping (constant tensors) and the table's
+//! row count.
 
 use burn::backend::Autodiff;
 use burn::backend::TensorMetadata;
@@ -15,15 +16,15 @@ use super::HashGridBackend;
 struct EncodeStep;
 
 impl<B: HashGridBackend> Backward<B, 1> for EncodeStep {
-    /// Weights, touched rows, offsets, sources, and the table's row count.
-    type State = (FloatTensor<B>, IntTensor<B>, IntTensor<B>, IntTensor<B>, usize);
+    /// Touched rows, offsets, grouped pairs and weights, and the table's row count.
+    type State = (IntTensor<B>, IntTensor<B>, IntTensor<B>, FloatTensor<B>, usize);
 
     fn backward(self, ops: Ops<Self::State, 1>, grads: &mut Gradients, _checkpointer: &mut Checkpointer) {
         let grad = grads.consume::<B>(&ops.node);
-        let (weights, touched, offsets, sources, table_rows) = ops.state;
+        let (touched, offsets, pairs, weights, table_rows) = ops.state;
         let [table] = ops.parents;
         if let Some(node) = table {
-            let d_table = B::hash_grid_backward(grad, weights, touched, offsets, sources, table_rows);
+            let d_table = B::hash_grid_backward(grad, touched, offsets, pairs, weights, table_rows);
             grads.register::<B>(node.id, d_table);
         }
     }
@@ -36,21 +37,23 @@ impl<B: HashGridBackend, C: CheckpointStrategy> HashGridBackend for Autodiff<B, 
         weights: FloatTensor<Self>,
         touched: IntTensor<Self>,
         offsets: IntTensor<Self>,
-        sources: IntTensor<Self>,
+        grouped_pairs: IntTensor<Self>,
+        grouped_weights: FloatTensor<Self>,
     ) -> FloatTensor<Self> {
         let table_rows = table.shape()[0];
-        let weights = weights.into_primitive();
+        let (weights, grouped_weights) = (weights.into_primitive(), grouped_weights.into_primitive());
         match EncodeStep.prepare::<C>([table.node()]).compute_bound().stateful() {
             OpsKind::Tracked(prep) => {
                 let out = B::hash_grid_forward(
                     table.into_primitive(),
                     rows,
-                    weights.clone(),
+                    weights,
                     touched.clone(),
                     offsets.clone(),
-                    sources.clone(),
+                    grouped_pairs.clone(),
+                    grouped_weights.clone(),
                 );
-                prep.finish((weights, touched, offsets, sources, table_rows), out)
+                prep.finish((touched, offsets, grouped_pairs, grouped_weights, table_rows), out)
             }
             OpsKind::UnTracked(prep) => prep.finish(B::hash_grid_forward(
                 table.into_primitive(),
@@ -58,7 +61,8 @@ impl<B: HashGridBackend, C: CheckpointStrategy> HashGridBackend for Autodiff<B, 
                 weights,
                 touched,
                 offsets,
-                sources,
+                grouped_pairs,
+                grouped_weights,
             )),
         }
     }
@@ -67,18 +71,18 @@ impl<B: HashGridBackend, C: CheckpointStrategy> HashGridBackend for Autodiff<B, 
     /// backend without recording it.
     fn hash_grid_backward(
         grad: FloatTensor<Self>,
-        weights: FloatTensor<Self>,
         touched: IntTensor<Self>,
         offsets: IntTensor<Self>,
-        sources: IntTensor<Self>,
+        grouped_pairs: IntTensor<Self>,
+        grouped_weights: FloatTensor<Self>,
         table_rows: usize,
     ) -> FloatTensor<Self> {
         FloatTensor::<Self>::new(B::hash_grid_backward(
             grad.into_primitive(),
-            weights.into_primitive(),
             touched,
             offsets,
-            sources,
+            grouped_pairs,
+            grouped_weights.into_primitive(),
             table_rows,
         ))
     }

@@ -7,6 +7,9 @@ use super::HashGridError;
 /// Primes of instant-ngp's spatial hash, one per axis (the first is 1 for cache coherence).
 pub const HASH_PRIMES: [u32; 3] = [1, 2_654_435_761, 805_459_861];
 
+/// Feature counts per level the kernels are compiled for (as in tiny-cuda-nn's grid encoding).
+pub const FEATURES_PER_LEVEL: [usize; 4] = [1, 2, 4, 8];
+
 /// The largest level resolution accepted: corner coordinates then stay exact in `f64` and fit
 /// the hash's `u32` arithmetic with room to spare.
 const MAX_RESOLUTION: u64 = 1 << 24;
@@ -22,7 +25,7 @@ pub struct HashGridConfig {
     pub base_resolution: u32,
     /// b, the factor between successive resolutions.
     pub growth: f64,
-    /// F, the features stored per table row.
+    /// F, the features stored per table row: 1, 2, 4 or 8.
     pub features_per_level: usize,
 }
 
@@ -74,8 +77,8 @@ impl HashGridConfig {
         if self.levels == 0 {
             return bad("at least one level is needed".into());
         }
-        if self.features_per_level == 0 {
-            return bad("at least one feature per level is needed".into());
+        if !FEATURES_PER_LEVEL.contains(&self.features_per_level) {
+            return bad(format!("{} features per level; use 1, 2, 4 or 8", self.features_per_level));
         }
         if !(1..=30).contains(&self.log2_table_size) {
             return bad(format!("log2 table size {} is not in 1..=30", self.log2_table_size));

@@ -8,8 +8,8 @@ use burn::backend::wgpu::CubeBackend;
 use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
 use burn_cubecl::kernel::into_contiguous;
 
+use super::HashGridBackend;
 use super::kernels::{encode_backward, encode_forward};
-use super::{CORNERS, HashGridBackend};
 
 /// Units per cube.
 const GROUP: u32 = 256;
@@ -29,12 +29,12 @@ impl HashGridBackend for CubeBackend {
         weights: FloatTensor<Self>,
         _touched: IntTensor<Self>,
         _offsets: IntTensor<Self>,
-        _sources: IntTensor<Self>,
+        _grouped_pairs: IntTensor<Self>,
+        _grouped_weights: FloatTensor<Self>,
     ) -> FloatTensor<Self> {
-        let (n, slots, f) = (rows.shape()[0], rows.shape()[1], table.shape()[1]);
+        let (pairs, f) = (rows.shape()[0], table.shape()[1]);
         let dtype = table.dtype();
-        let out = Self::float_empty([n, slots / CORNERS * f].into(), &table.device, dtype.into());
-        let pairs = n * slots / CORNERS;
+        let out = Self::float_empty([pairs, f].into(), &table.device, dtype.into());
         encode_forward::launch(
             &table.client.clone(),
             grid(pairs),
@@ -52,13 +52,13 @@ impl HashGridBackend for CubeBackend {
 
     fn hash_grid_backward(
         grad: FloatTensor<Self>,
-        weights: FloatTensor<Self>,
         touched: IntTensor<Self>,
         offsets: IntTensor<Self>,
-        sources: IntTensor<Self>,
+        grouped_pairs: IntTensor<Self>,
+        grouped_weights: FloatTensor<Self>,
         table_rows: usize,
     ) -> FloatTensor<Self> {
-        let f = grad.shape()[1] * CORNERS / weights.shape()[1];
+        let f = grad.shape()[1];
         let dtype = grad.dtype();
         let d_table = Self::float_zeros([table_rows, f].into(), &grad.device, dtype.into());
         let rows = touched.shape()[0];
@@ -67,10 +67,10 @@ impl HashGridBackend for CubeBackend {
             grid(rows),
             CubeDim::new_1d(GROUP),
             into_contiguous(grad).into_buffer_arg(),
-            into_contiguous(weights).into_buffer_arg(),
             into_contiguous(touched).into_buffer_arg(),
             into_contiguous(offsets).into_buffer_arg(),
-            into_contiguous(sources).into_buffer_arg(),
+            into_contiguous(grouped_pairs).into_buffer_arg(),
+            into_contiguous(grouped_weights).into_buffer_arg(),
             d_table.clone().into_buffer_arg(),
             u32_of(rows),
             f,

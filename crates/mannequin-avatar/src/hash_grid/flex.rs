@@ -1,6 +1,7 @@
-//! The op on Flex: rayon over points (forward) and over blocks of table rows (backward). Every
-//! output element is written by one task and summed in a fixed order, so results are
-//! bit-identical from run to run whatever the thread count.
+//! The op on Flex: rayon over (level, point) pairs (forward) and over table rows (backward).
+//! Each output row is computed by one task and summed in a fixed order, so results are
+//! bit-identical from run to run whatever the thread count. The feature count is a compile-time
+//! constant so each row's sums stay in registers.
 
 use std::ops::{AddAssign, Mul};
 
@@ -13,13 +14,14 @@ use rayon::prelude::*;
 
 use super::{CORNERS, HashGridBackend};
 
-/// Table rows per backward task: large enough to amortise the task, small enough to balance.
+/// (level, point) pairs per forward task.
+const PAIRS_PER_TASK: usize = 1024;
+
+/// Table rows per backward task: large enough to amortise the task and its search of the
+/// touched rows, small enough to balance the load.
 const ROWS_PER_TASK: usize = 4096;
 
-/// Points per forward task.
-const POINTS_PER_TASK: usize = 64;
-
-const LAYOUT: &str = "hash-grid tensors have the dtypes `encode` checked";
+const LAYOUT: &str = "hash-grid tensors have the dtypes and shapes `encode` checked";
 
 trait Real: Copy + Default + Send + Sync + Mul<Output = Self> + AddAssign {}
 impl<T: Copy + Default + Send + Sync + Mul<Output = T> + AddAssign> Real for T {}
@@ -32,68 +34,96 @@ fn ints(t: &FlexTensor) -> &[i32] {
     t.as_slice::<i32>().expect(LAYOUT)
 }
 
+/// `out[p] = Σ_c weights[p·8 + c] · table[rows[p·8 + c]]` for every (level, point) pair `p`, in
+/// order, so each thread walks through one level's table slice at a time.
+fn forward<T: Real, const F: usize>(table: &[T], rows: &[i32], weights: &[T]) -> Vec<T> {
+    let mut out: Vec<[T; F]> = Vec::new();
+    rows.par_chunks(CORNERS)
+        .zip(weights.par_chunks(CORNERS))
+        .with_min_len(PAIRS_PER_TASK)
+        .map(|(rows, weights)| {
+            let mut acc = [T::default(); F];
+            for (&row, &w) in rows.iter().zip(weights) {
+                for (a, &t) in acc.iter_mut().zip(&table[row as usize * F..][..F]) {
+                    *a += w * t;
+                }
+            }
+            acc
+        })
+        .collect_into_vec(&mut out);
+    out.into_flattened()
+}
+
 /// The lookup's entries grouped by table row (see `lookup.rs`).
-#[derive(Clone, Copy)]
-struct Groups<'a> {
+struct Groups<'a, T> {
     touched: &'a [i32],
     offsets: &'a [i32],
-    sources: &'a [i32],
+    pairs: &'a [i32],
+    weights: &'a [T],
 }
 
-/// `out[p·F + k] = Σ_c weights[p·8 + c] · table[rows[p·8 + c]·F + k]` for every (point, level)
-/// pair `p`.
-fn forward<T: Real>(table: &[T], rows: &[i32], weights: &[T], slots: usize, f: usize) -> Vec<T> {
-    let pairs = rows.len() / CORNERS;
-    let mut out = vec![T::default(); pairs * f];
-    let per_point = slots / CORNERS * f;
-    out.par_chunks_mut(per_point)
-        .zip(rows.par_chunks(slots).zip(weights.par_chunks(slots)))
-        .with_min_len(POINTS_PER_TASK)
-        .for_each(|(out, (rows, weights))| {
-            for (s, (&row, &w)) in rows.iter().zip(weights).enumerate() {
-                let o = &mut out[s / CORNERS * f..][..f];
-                for (o, &t) in o.iter_mut().zip(&table[row as usize * f..][..f]) {
-                    *o += w * t;
-                }
-            }
-        });
-    out
-}
-
-/// The table gradient: one zeroed allocation; each task owns a block of rows and fills the
-/// touched ones from their entries in ascending order.
-fn backward<T: Real>(grad: &[T], weights: &[T], groups: &Groups, table_rows: usize, f: usize) -> Vec<T> {
-    let Groups { touched, offsets, sources } = *groups;
-    let mut d = vec![T::default(); table_rows * f];
-    d.par_chunks_mut(ROWS_PER_TASK * f).enumerate().for_each(|(block, d)| {
-        let first = block * ROWS_PER_TASK;
-        let lo = touched.partition_point(|&r| (r as usize) < first);
-        let hi = touched.partition_point(|&r| (r as usize) < first + d.len() / f);
-        for t in lo..hi {
-            let out = &mut d[(touched[t] as usize - first) * f..][..f];
-            for &s in &sources[offsets[t] as usize..offsets[t + 1] as usize] {
-                let s = s as usize;
-                let w = weights[s];
-                for (o, &g) in out.iter_mut().zip(&grad[s / CORNERS * f..][..f]) {
-                    *o += w * g;
-                }
+impl<T: Real> Groups<'_, T> {
+    /// Row `touched[t]`'s gradient: its entries' `weight · grad[pair]`, in ascending order.
+    fn row_sum<const F: usize>(&self, t: usize, grad: &[T]) -> [T; F] {
+        let entries = self.offsets[t] as usize..self.offsets[t + 1] as usize;
+        let mut acc = [T::default(); F];
+        for (&p, &w) in self.pairs[entries.clone()].iter().zip(&self.weights[entries]) {
+            for (a, &g) in acc.iter_mut().zip(&grad[p as usize * F..][..F]) {
+                *a += w * g;
             }
         }
+        acc
+    }
+}
+
+/// The `[table_rows, F]` table gradient: one zeroed allocation; each task owns a block of rows
+/// and writes the touched ones.
+fn backward<T: Real, const F: usize>(grad: &[T], groups: &Groups<T>, table_rows: usize) -> Vec<T> {
+    let touched = groups.touched;
+    let mut d = vec![[T::default(); F]; table_rows];
+    d.par_chunks_mut(ROWS_PER_TASK).enumerate().for_each(|(block, d)| {
+        let first = block * ROWS_PER_TASK;
+        let lo = touched.partition_point(|&r| (r as usize) < first);
+        let hi = touched.partition_point(|&r| (r as usize) < first + d.len());
+        for t in lo..hi {
+            d[touched[t] as usize - first] = groups.row_sum::<F>(t, grad);
+        }
     });
-    d
+    d.into_flattened()
 }
 
 /// Evaluates `$body` with `$T` naming the element type of float dtype `$dtype` (f64, else f32:
-/// `encode` admits no other).
-macro_rules! with_float {
-    ($dtype:expr, $T:ident => $body:expr) => {
+/// `encode` admits no other) and `$F` the feature count `$f` (1, 2, 4 or 8: the config admits
+/// no other).
+macro_rules! with_types {
+    ($dtype:expr, $f:expr, $T:ident, $F:ident => $body:expr) => {
         match $dtype {
             DType::F64 => {
                 type $T = f64;
-                $body
+                with_types!(@features $f, $F => $body)
             }
             _ => {
                 type $T = f32;
+                with_types!(@features $f, $F => $body)
+            }
+        }
+    };
+    (@features $f:expr, $F:ident => $body:expr) => {
+        match $f {
+            1 => {
+                const $F: usize = 1;
+                $body
+            }
+            2 => {
+                const $F: usize = 2;
+                $body
+            }
+            4 => {
+                const $F: usize = 4;
+                $body
+            }
+            _ => {
+                const $F: usize = 8;
                 $body
             }
         }
@@ -107,34 +137,41 @@ impl HashGridBackend for Flex {
         weights: FloatTensor<Self>,
         _touched: IntTensor<Self>,
         _offsets: IntTensor<Self>,
-        _sources: IntTensor<Self>,
+        _grouped_pairs: IntTensor<Self>,
+        _grouped_weights: FloatTensor<Self>,
     ) -> FloatTensor<Self> {
         let [table, rows, weights] = [table, rows, weights].map(contiguous);
-        let (n, slots, f) = (rows.shape()[0], rows.shape()[1], table.shape()[1]);
-        let shape = vec![n, slots / CORNERS * f];
-        let data = with_float!(table.dtype(), T => {
+        let (pairs, f) = (rows.shape()[0], table.shape()[1]);
+        let data = with_types!(table.dtype(), f, T, F => {
             let (table, weights) = (table.as_slice::<T>().expect(LAYOUT), weights.as_slice::<T>().expect(LAYOUT));
-            TensorData::new(forward(table, ints(&rows), weights, slots, f), shape)
+            TensorData::new(forward::<T, F>(table, ints(&rows), weights), vec![pairs, f])
         });
         FlexTensor::from_data(data)
     }
 
     fn hash_grid_backward(
         grad: FloatTensor<Self>,
-        weights: FloatTensor<Self>,
         touched: IntTensor<Self>,
         offsets: IntTensor<Self>,
-        sources: IntTensor<Self>,
+        grouped_pairs: IntTensor<Self>,
+        grouped_weights: FloatTensor<Self>,
         table_rows: usize,
     ) -> FloatTensor<Self> {
-        let [grad, weights, touched, offsets, sources] =
-            [grad, weights, touched, offsets, sources].map(contiguous);
-        let f = grad.shape()[1] * CORNERS / weights.shape()[1];
-        let groups = Groups { touched: ints(&touched), offsets: ints(&offsets), sources: ints(&sources) };
-        let data = with_float!(grad.dtype(), T => {
-            let (grad, weights) = (grad.as_slice::<T>().expect(LAYOUT), weights.as_slice::<T>().expect(LAYOUT));
-            TensorData::new(backward(grad, weights, &groups, table_rows, f), vec![table_rows, f])
+        let [grad, touched, offsets, pairs, weights] =
+            [grad, touched, offsets, grouped_pairs, grouped_weights].map(contiguous);
+        let f = grad.shape()[1];
+        let t0 = std::time::Instant::now();
+        let data = with_types!(grad.dtype(), f, T, F => {
+            let groups = Groups {
+                touched: ints(&touched),
+                offsets: ints(&offsets),
+                pairs: ints(&pairs),
+                weights: weights.as_slice::<T>().expect(LAYOUT),
+            };
+            let grad = grad.as_slice::<T>().expect(LAYOUT);
+            TensorData::new(backward::<T, F>(grad, &groups, table_rows), vec![table_rows, f])
         });
+        eprintln!("bwd {:.2}", t0.elapsed().as_secs_f64() * 1e3);
         FlexTensor::from_data(data)
     }
 }

@@ -1,5 +1,5 @@
 //! CubeCL kernels of the encoding, generic over the float type. Both are gathers: the forward
-//! reads the 8 corner rows of a (point, level) cell, the backward reads the entries grouped
+//! reads the 8 corner rows of a (level, point) cell, the backward reads the entries grouped
 //! under one table row (see `lookup.rs`), so no unit writes where another does and the result
 //! does not depend on scheduling.
 //!
@@ -10,10 +10,10 @@
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
-/// Corners per cell; entry `s` belongs to the (point, level) pair `s / CORNERS`.
+/// Corners per cell: pair `p`'s entries are `p·8 .. p·8 + 8`.
 const CORNERS: usize = 8;
 
-/// One unit per (point, level) pair `p`: `out[p, k] = Σ_c weights[p, c] · table[rows[p, c], k]`.
+/// One unit per (level, point) pair `p`: `out[p, k] = Σ_c weights[p, c] · table[rows[p, c], k]`.
 #[cube(launch)]
 pub(crate) fn encode_forward<F: Float>(
     table: &[F],
@@ -49,16 +49,15 @@ pub(crate) fn encode_forward<F: Float>(
     }
 }
 
-/// One unit per touched table row `t`: `d_table[row, k] = Σ_s weights[s] · grad[s / 8, k]` over
-/// the row's entries `s`, in ascending order. Rows no entry uses keep their zeros.
-#[allow(clippy::needless_range_loop)] // kernels index; CubeCL has no slice iterators
+/// One unit per touched table row `t`: `d_table[row, k] = Σ_e weights[e] · grad[pairs[e], k]`
+/// over the row's entries `e`, in ascending order. Rows no entry uses keep their zeros.
 #[cube(launch)]
 pub(crate) fn encode_backward<F: Float>(
     grad: &[F],
-    weights: &[F],
     touched: &[i32],
     offsets: &[i32],
-    sources: &[i32],
+    pairs: &[i32],
+    weights: &[F],
     d_table: &mut [F],
     rows: u32,
     #[comptime] features: usize,
@@ -76,9 +75,8 @@ pub(crate) fn encode_backward<F: Float>(
     let start = usize::cast_from(offsets[t]);
     let end = usize::cast_from(offsets[t + 1]);
     for e in start..end {
-        let s = usize::cast_from(sources[e]);
-        let w = weights[s];
-        let g = (s / CORNERS) * features;
+        let w = weights[e];
+        let g = usize::cast_from(pairs[e]) * features;
         #[unroll]
         for k in 0..features {
             acc[k] += w * grad[g + k];

@@ -2,6 +2,10 @@
 //! that depends only on them is computed once on the host: for each point, level and corner,
 //! the table row and the trilinear weight; and the same entries grouped by table row, so the
 //! backward pass can sum each row's gradient in a fixed order without atomics.
+//!
+//! Entries are stored level-major, `[L, N, 8]`: a pass over them reads one level's slice of the
+//! table (T rows, 1 MiB by default) at a time, which stays in a CPU core's L2 cache, where a
+//! point-major pass would jump across the whole table (16 MiB) at every point.
 
 use burn::tensor::{DType, Device, Int, Tensor, TensorData};
 use rayon::prelude::*;
@@ -15,16 +19,20 @@ pub const CORNERS: usize = 8;
 #[derive(Clone, Debug)]
 pub struct HashGridLookup {
     config: HashGridConfig,
-    /// `[N, L, 8]` table rows (`l·T` + index), as `i32` so every backend can read them.
+    /// `[L, N, 8]` table rows (`l·T` + index), as `i32` so every backend can read them.
     rows: Vec<i32>,
-    /// `[N, L, 8]` trilinear weights.
+    /// `[L, N, 8]` trilinear weights.
     weights: Vec<f64>,
     /// The table rows that some entry uses, ascending.
     touched: Vec<i32>,
-    /// `touched[k]`'s entries are `sources[offsets[k]..offsets[k + 1]]`.
+    /// `touched[k]`'s entries are `offsets[k]..offsets[k + 1]` of the two arrays below.
     offsets: Vec<i32>,
-    /// Entry indices (into `rows` / `weights`) grouped by row, ascending within a row.
-    sources: Vec<i32>,
+    /// The (level, point) pair `l·N + i` of each entry, grouped by row; within a row in
+    /// ascending entry order.
+    grouped_pairs: Vec<i32>,
+    /// The weight of each entry, in the same order: the backward pass then reads weights
+    /// sequentially, and only the upstream gradient at random.
+    grouped_weights: Vec<f64>,
 }
 
 impl HashGridLookup {
@@ -34,24 +42,21 @@ impl HashGridLookup {
         if points.is_empty() {
             return Err(HashGridError::NoPoints);
         }
-        let slots = config.levels * CORNERS;
-        if points.len().checked_mul(slots).is_none_or(|e| e > i32::MAX as usize) {
-            return Err(HashGridError::TooManyPoints(points.len()));
+        let n = points.len();
+        if n.checked_mul(config.levels * CORNERS).is_none_or(|e| e > i32::MAX as usize) {
+            return Err(HashGridError::TooManyPoints(n));
         }
         let unit: Vec<[f64; 3]> =
             points.iter().enumerate().map(|(i, &p)| aabb.normalise(i, p)).collect::<Result<_, _>>()?;
-        let entries = points.len() * slots;
+        let entries = config.levels * n * CORNERS;
         let (mut rows, mut weights) = (vec![0i32; entries], vec![0f64; entries]);
-        rows.par_chunks_mut(slots).zip(weights.par_chunks_mut(slots)).zip(&unit).for_each(
-            |((rows, weights), u)| {
-                for l in 0..config.levels {
-                    let at = l * CORNERS;
-                    interpolate(config, l, u, &mut rows[at..at + CORNERS], &mut weights[at..at + CORNERS]);
-                }
-            },
+        rows.par_chunks_mut(CORNERS).zip(weights.par_chunks_mut(CORNERS)).enumerate().for_each(
+            |(pair, (rows, weights))| interpolate(config, pair / n, &unit[pair % n], rows, weights),
         );
         let (touched, offsets, sources) = group_by_row(&rows, config.table_rows());
-        Ok(Self { config: *config, rows, weights, touched, offsets, sources })
+        let grouped_pairs = sources.iter().map(|&s| s / CORNERS as i32).collect();
+        let grouped_weights = sources.iter().map(|&s| weights[s as usize]).collect();
+        Ok(Self { config: *config, rows, weights, touched, offsets, grouped_pairs, grouped_weights })
     }
 
     pub fn config(&self) -> &HashGridConfig {
@@ -62,34 +67,40 @@ impl HashGridLookup {
         self.rows.len() / (self.config.levels * CORNERS)
     }
 
-    /// `[N, L, 8]` table rows.
+    /// `[L, N, 8]` table rows: entry `(l·N + i)·8 + c` is corner `c` of point `i`'s cell at
+    /// level `l`, whose bit `k` set means one step along axis `k`.
     pub fn rows(&self) -> &[i32] {
         &self.rows
     }
 
-    /// `[N, L, 8]` trilinear weights.
+    /// `[L, N, 8]` trilinear weights, in the order of [`rows`](Self::rows).
     pub fn weights(&self) -> &[f64] {
         &self.weights
     }
 
     /// Uploads the lookup to `device`, with weights in `dtype` (the table's dtype: f32 or f64).
     pub fn to_device(&self, device: &Device, dtype: DType) -> Result<DeviceLookup, HashGridError> {
-        let shape = [self.num_points(), self.config.levels * CORNERS];
-        let weights = match dtype {
-            DType::F64 => TensorData::new(self.weights.clone(), shape),
-            DType::F32 => TensorData::new(self.weights.iter().map(|&w| w as f32).collect(), shape),
-            other => return Err(HashGridError::UnsupportedDtype(other)),
+        let shape = [self.rows.len() / CORNERS, CORNERS];
+        let floats = |v: &[f64], shape: Vec<usize>| match dtype {
+            DType::F64 => Ok(TensorData::new(v.to_vec(), shape)),
+            DType::F32 => Ok(TensorData::new(v.iter().map(|&w| w as f32).collect(), shape)),
+            other => Err(HashGridError::UnsupportedDtype(other)),
         };
         let ints = |v: &[i32]| {
             Tensor::<1, Int>::from_data(TensorData::new(v.to_vec(), [v.len()]), (device, DType::I32))
         };
+        let entries = self.grouped_weights.len();
         Ok(DeviceLookup {
             config: self.config,
             rows: Tensor::from_data(TensorData::new(self.rows.clone(), shape), (device, DType::I32)),
-            weights: Tensor::from_data(weights, (device, dtype)),
+            weights: Tensor::from_data(floats(&self.weights, shape.to_vec())?, (device, dtype)),
             touched: ints(&self.touched),
             offsets: ints(&self.offsets),
-            sources: ints(&self.sources),
+            grouped_pairs: ints(&self.grouped_pairs),
+            grouped_weights: Tensor::from_data(
+                floats(&self.grouped_weights, vec![entries])?,
+                (device, dtype),
+            ),
         })
     }
 }
@@ -124,7 +135,8 @@ fn interpolate(config: &HashGridConfig, l: usize, u: &[f64; 3], rows: &mut [i32]
     }
 }
 
-/// Counting sort of the entries by table row: `(touched rows, offsets, entry indices)`.
+/// Counting sort of the entries by table row: `(touched rows, offsets, entry indices)`; within a
+/// row, entries keep ascending order.
 fn group_by_row(rows: &[i32], table_rows: usize) -> (Vec<i32>, Vec<i32>, Vec<i32>) {
     let mut cursor = vec![0u32; table_rows];
     for &r in rows {
@@ -157,7 +169,8 @@ pub struct DeviceLookup {
     pub(crate) weights: Tensor<2>,
     pub(crate) touched: Tensor<1, Int>,
     pub(crate) offsets: Tensor<1, Int>,
-    pub(crate) sources: Tensor<1, Int>,
+    pub(crate) grouped_pairs: Tensor<1, Int>,
+    pub(crate) grouped_weights: Tensor<1>,
 }
 
 impl DeviceLookup {
@@ -166,6 +179,6 @@ impl DeviceLookup {
     }
 
     pub fn num_points(&self) -> usize {
-        self.rows.dims()[0]
+        self.rows.dims()[0] / self.config.levels
     }
 }

@@ -36,42 +36,45 @@ use burn::backend::tensor::{FloatTensor, IntTensor};
 use burn::backend::{Backend, Dispatch, backend_extension};
 use burn::tensor::Tensor;
 
-pub use config::{Aabb, HASH_PRIMES, HashGridConfig, Level, spatial_hash};
+pub use config::{Aabb, FEATURES_PER_LEVEL, HASH_PRIMES, HashGridConfig, Level, spatial_hash};
 pub use error::HashGridError;
 pub use init::{INIT_SCALE, init_table};
 pub use lookup::{CORNERS, DeviceLookup, HashGridLookup};
 
-/// Backends that can run the encoding. The integer tensors are a [`DeviceLookup`]'s: `rows` and
-/// `weights` are `[N, L·8]`; `touched`, `offsets` and `sources` group the entries by table row.
-/// [`encode`] is the checked entry point.
+/// Backends that can run the encoding, on a [`DeviceLookup`]'s tensors: `rows` and `weights` are
+/// `[L·N, 8]` (level-major: pair `p = l·N + i` is point `i` at level `l`); `touched` lists the
+/// table rows in use, and row `touched[t]`'s entries are `offsets[t]..offsets[t + 1]` of
+/// `grouped_pairs` (their pairs `p`) and `grouped_weights`. [`encode`] is the checked entry point.
 #[backend_extension(Flex, Cube, Autodiff)]
 pub trait HashGridBackend: Backend {
-    /// `[N, L·F]` features: `out[i, l·F + k] = Σ_c weights[i, l·8 + c] · table[rows[i, l·8 + c], k]`.
-    /// The grouping tensors are not read here; they ride along so the autodiff layer can hand
-    /// them to the backward pass.
+    /// `[L·N, F]` features: `out[p, k] = Σ_c weights[p, c] · table[rows[p, c], k]`. The grouping
+    /// tensors are not read here; they ride along so the autodiff layer can hand them to the
+    /// backward pass.
     fn hash_grid_forward(
         table: FloatTensor<Self>,
         rows: IntTensor<Self>,
         weights: FloatTensor<Self>,
         touched: IntTensor<Self>,
         offsets: IntTensor<Self>,
-        sources: IntTensor<Self>,
+        grouped_pairs: IntTensor<Self>,
+        grouped_weights: FloatTensor<Self>,
     ) -> FloatTensor<Self>;
 
-    /// The `[table_rows, F]` gradient of the table given the gradient `grad` `[N, L·F]` of the
+    /// The `[table_rows, F]` gradient of the table given the gradient `grad` `[L·N, F]` of the
     /// features: each touched row sums `weight · grad` over its entries in ascending order.
     fn hash_grid_backward(
         grad: FloatTensor<Self>,
-        weights: FloatTensor<Self>,
         touched: IntTensor<Self>,
         offsets: IntTensor<Self>,
-        sources: IntTensor<Self>,
+        grouped_pairs: IntTensor<Self>,
+        grouped_weights: FloatTensor<Self>,
         table_rows: usize,
     ) -> FloatTensor<Self>;
 }
 
-/// The `[N, L·F]` encoding of the lookup's points, differentiable with respect to `table`
-/// (`[L·T, F]`, on the lookup's device and in its dtype).
+/// The `[N, L·F]` encoding of the lookup's points (point `i`'s level `l` features at columns
+/// `l·F .. (l+1)·F`), differentiable with respect to `table` (`[L·T, F]`, on the lookup's device
+/// and in its dtype).
 pub fn encode(lookup: &DeviceLookup, table: Tensor<2>) -> Result<Tensor<2>, HashGridError> {
     let config = &lookup.config;
     let expected = [config.table_rows(), config.features_per_level];
@@ -88,7 +91,9 @@ pub fn encode(lookup: &DeviceLookup, table: Tensor<2>) -> Result<Tensor<2>, Hash
         lookup.weights.clone().into_dispatch(),
         lookup.touched.clone().into_dispatch(),
         lookup.offsets.clone().into_dispatch(),
-        lookup.sources.clone().into_dispatch(),
+        lookup.grouped_pairs.clone().into_dispatch(),
+        lookup.grouped_weights.clone().into_dispatch(),
     );
-    Ok(Tensor::from_dispatch(features))
+    let (l, n, f) = (config.levels, lookup.num_points(), config.features_per_level);
+    Ok(Tensor::<2>::from_dispatch(features).reshape([l, n, f]).swap_dims(0, 1).reshape([n, l * f]))
 }
