@@ -7,6 +7,7 @@ pub mod avatar;
 pub mod canonical;
 pub mod config;
 pub mod error;
+pub mod export;
 pub mod field;
 pub mod hash_grid;
 pub mod ihuman;

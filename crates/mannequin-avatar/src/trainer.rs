@@ -76,6 +76,21 @@ pub struct Trainer {
     adam: Adam,
     views: Vec<View>,
     topology: MeshTopology,
+    /// 1 / (mean canonical edge length)²: makes the Laplacian term unit-free, so λ_m weighs it
+    /// like the (unit-free) normal consistency whatever the mesh resolution.
+    laplacian_scale: f64,
+}
+
+/// Mean edge length of the canonical mesh (each edge counted once per face side).
+fn mean_edge_length(c: &crate::canonical::Canonical) -> f64 {
+    let mut sum = 0.0;
+    for f in &c.faces {
+        for k in 0..3 {
+            let (a, b) = (c.vertices[f[k] as usize], c.vertices[f[(k + 1) % 3] as usize]);
+            sum += ((0..3).map(|i| (a[i] - b[i]) as f64 * (a[i] - b[i]) as f64).sum::<f64>()).sqrt();
+        }
+    }
+    sum / (3 * c.faces.len()).max(1) as f64
 }
 
 /// View order of one epoch: a seeded Fisher–Yates shuffle, a pure function of (seed, epoch) so
@@ -110,7 +125,8 @@ impl Trainer {
         let topology =
             MeshTopology::new(avatar.canonical.num_vertices(), &avatar.canonical.faces, avatar.device())?;
         let adam = Adam::new(&avatar.params);
-        Ok(Self { avatar, options, iteration: 0, adam, views, topology })
+        let laplacian_scale = mean_edge_length(&avatar.canonical).max(1e-6).powi(-2);
+        Ok(Self { avatar, options, iteration: 0, adam, views, topology, laplacian_scale })
     }
 
     pub fn num_views(&self) -> usize {
@@ -195,8 +211,8 @@ impl Trainer {
             Tensor::from_data(TensorData::new(view.mask.clone(), [crop.height, crop.width]), &device);
         loss = loss + (alpha - mask).abs().mean() * o.lambda_mask;
         // Laplacian smoothness of the offset field and normal consistency of V_s (Eq. 15).
-        let mesh =
-            self.topology.laplacian(offsets)? + self.topology.normal_consistency(personalised.clone())?;
+        let mesh = self.topology.laplacian(offsets)? * self.laplacian_scale
+            + self.topology.normal_consistency(personalised.clone())?;
         loss = loss + mesh * o.lambda_mesh;
         if o.lambda_equilateral > 0.0 {
             loss = loss + self.topology.equilateral(personalised)? * o.lambda_equilateral;
@@ -249,7 +265,7 @@ impl Trainer {
 
     /// Writes parameters, optimiser moments and the iteration count atomically.
     pub fn save_checkpoint(&self, path: &Path) -> Result<(), AvatarError> {
-        let mut w = NpzWriter::new();
+        let mut w = NpzWriter::uncompressed();
         w.add("iteration", NpyArray::i64(vec![1], vec![self.iteration as i64]));
         w.add("seed", NpyArray::i64(vec![1], vec![self.options.seed as i64]));
         for p in &self.avatar.params {

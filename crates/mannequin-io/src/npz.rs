@@ -108,6 +108,7 @@ fn check_shape(npz: &Npz, key: &str, shape: &[usize], expected: &[Option<usize>]
 #[derive(Debug, Default)]
 pub struct NpzWriter {
     arrays: Vec<(String, NpyArray)>,
+    stored: bool,
 }
 
 impl NpzWriter {
@@ -115,17 +116,25 @@ impl NpzWriter {
         Self::default()
     }
 
+    /// Entries stored without compression (as `numpy.savez`): for large float arrays written
+    /// often, such as training checkpoints, deflate costs seconds and saves little.
+    pub fn uncompressed() -> Self {
+        Self { stored: true, ..Self::default() }
+    }
+
     pub fn add(&mut self, key: &str, array: NpyArray) -> &mut Self {
         self.arrays.push((key.to_string(), array));
         self
     }
 
-    /// The archive bytes (deflate-compressed entries, as `numpy.savez_compressed` writes).
+    /// The archive bytes (deflate-compressed entries, as `numpy.savez_compressed` writes, unless
+    /// [`NpzWriter::uncompressed`]).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
-        let opts = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Deflated)
-            .large_file(false);
+        let method =
+            if self.stored { zip::CompressionMethod::Stored } else { zip::CompressionMethod::Deflated };
+        // ZIP64 only where an entry needs it (over 4 GiB stays an error otherwise).
+        let opts = zip::write::SimpleFileOptions::default().compression_method(method).large_file(false);
         for (key, array) in &self.arrays {
             // Writing into memory cannot fail except on allocation failure.
             zip.start_file(format!("{key}.npy"), opts).expect("in-memory zip entry");
@@ -157,6 +166,18 @@ mod tests {
         let npz = Npz::from_bytes("mem.npz".into(), &sample().to_bytes()).unwrap();
         assert_eq!(npz.keys().collect::<Vec<_>>(), vec!["a", "b"]);
         assert_eq!(npz.require("b").unwrap().to_i64().unwrap(), vec![7, 8, 9]);
+    }
+
+    #[test]
+    fn uncompressed_round_trip_holds_the_raw_bytes() {
+        let mut w = NpzWriter::uncompressed();
+        let values: Vec<f32> = (0..1000).map(|i| i as f32).collect();
+        w.add("x", NpyArray::f32(vec![1000], values.clone()));
+        let bytes = w.to_bytes();
+        // Stored entries carry the 4,000 data bytes verbatim.
+        assert!(bytes.len() > 4000);
+        let npz = Npz::from_bytes("mem.npz".into(), &bytes).unwrap();
+        assert_eq!(npz.require("x").unwrap().to_f32().unwrap(), values);
     }
 
     #[test]

@@ -187,6 +187,15 @@ pub fn train(mut trainer: Trainer, args: &Args) -> Result<()> {
         progress.set_message(format!("loss {:.4} psnr {p:.1}", stats.loss));
         if stats.iteration % args.checkpoint_every == 0 || stats.iteration == args.iters {
             trainer.save_checkpoint(&checkpoint)?;
+            if progress.is_hidden() {
+                // No terminal: keep a log line per checkpoint instead of the bar.
+                tracing::info!(
+                    "iteration {}/{}: loss {:.4}, running PSNR {p:.2} dB",
+                    stats.iteration,
+                    args.iters,
+                    stats.loss
+                );
+            }
         }
     }
     progress.finish_and_clear();
