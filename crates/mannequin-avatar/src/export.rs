@@ -376,7 +376,7 @@ mod tests {
     #[test]
     fn face_colours_are_area_weighted() {
         // Two triangles sharing the edge 1–2: areas 0.5 and 1.5.
-        let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [3.0, 3.0, 0.0]];
+        let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, 2.0, 0.0]];
         let faces = [[0, 1, 2], [1, 3, 2]];
         let rgb = [[1.0, 0.0, 0.2], [0.0, 1.0, 0.6]];
         let binding = Binding { per_face: true, per_vertex: false };
