@@ -83,7 +83,7 @@ impl HashGridConfig {
         if !(1..=30).contains(&self.log2_table_size) {
             return bad(format!("log2 table size {} is not in 1..=30", self.log2_table_size));
         }
-        if self.table_rows() > i32::MAX as usize {
+        if self.levels.checked_mul(self.table_size()).is_none_or(|rows| rows > i32::MAX as usize) {
             return bad(format!(
                 "{} levels of 2^{} rows overflow i32 rows",
                 self.levels, self.log2_table_size

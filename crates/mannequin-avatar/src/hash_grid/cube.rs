@@ -5,21 +5,19 @@ use burn::backend::cubecl::dtype_to_elem_type;
 use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::{FloatTensor, IntTensor};
 use burn::backend::wgpu::CubeBackend;
-use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
+use burn_cubecl::cubecl::calculate_cube_count_elemwise;
+use burn_cubecl::cubecl::prelude::CubeDim;
 use burn_cubecl::kernel::into_contiguous;
 
 use super::HashGridBackend;
 use super::kernels::{encode_backward, encode_forward};
 
-/// Units per cube.
+/// Units per cube. The cube count spreads over the grid's dimensions when one would exceed its
+/// limit; the kernels read the linear `ABSOLUTE_POS`.
 const GROUP: u32 = 256;
 
 fn u32_of(v: usize) -> u32 {
     u32::try_from(v).expect("hash-grid sizes were checked to fit i32")
-}
-
-fn grid(units: usize) -> CubeCount {
-    CubeCount::Static(u32_of(units).div_ceil(GROUP), 1, 1)
 }
 
 impl HashGridBackend for CubeBackend {
@@ -37,7 +35,7 @@ impl HashGridBackend for CubeBackend {
         let out = Self::float_empty([pairs, f].into(), &table.device, dtype.into());
         encode_forward::launch(
             &table.client.clone(),
-            grid(pairs),
+            calculate_cube_count_elemwise(&table.client, pairs, CubeDim::new_1d(GROUP)),
             CubeDim::new_1d(GROUP),
             into_contiguous(table).into_buffer_arg(),
             into_contiguous(rows).into_buffer_arg(),
@@ -64,7 +62,7 @@ impl HashGridBackend for CubeBackend {
         let rows = touched.shape()[0];
         encode_backward::launch(
             &grad.client.clone(),
-            grid(rows),
+            calculate_cube_count_elemwise(&grad.client, rows, CubeDim::new_1d(GROUP)),
             CubeDim::new_1d(GROUP),
             into_contiguous(grad).into_buffer_arg(),
             into_contiguous(touched).into_buffer_arg(),

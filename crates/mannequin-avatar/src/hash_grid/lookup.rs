@@ -10,7 +10,7 @@
 use burn::tensor::{DType, Device, Int, Tensor, TensorData};
 use rayon::prelude::*;
 
-use super::{Aabb, HashGridConfig, HashGridError};
+use super::{Aabb, HashGridConfig, HashGridError, Level};
 
 /// Corners of a grid cell; corner `c` is offset by one along axis `k` when bit `k` of `c` is set.
 pub const CORNERS: usize = 8;
@@ -50,8 +50,9 @@ impl HashGridLookup {
             points.iter().enumerate().map(|(i, &p)| aabb.normalise(i, p)).collect::<Result<_, _>>()?;
         let entries = config.levels * n * CORNERS;
         let (mut rows, mut weights) = (vec![0i32; entries], vec![0f64; entries]);
+        let levels: Vec<Level> = (0..config.levels).map(|l| config.level(l)).collect();
         rows.par_chunks_mut(CORNERS).zip(weights.par_chunks_mut(CORNERS)).enumerate().for_each(
-            |(pair, (rows, weights))| interpolate(config, pair / n, &unit[pair % n], rows, weights),
+            |(pair, (rows, weights))| interpolate(&levels[pair / n], &unit[pair % n], rows, weights),
         );
         let (touched, offsets, sources) = group_by_row(&rows, config.table_rows());
         let grouped_pairs = sources.iter().map(|&s| s / CORNERS as i32).collect();
@@ -105,11 +106,10 @@ impl HashGridLookup {
     }
 }
 
-/// Rows and trilinear weights of unit-cube point `u` at level `l` (instant-ngp Sec. 3: scale by
+/// Rows and trilinear weights of unit-cube point `u` at `level` (instant-ngp Sec. 3: scale by
 /// N_l, take the enclosing cell, weight each corner by the product of per-axis fractions). A
 /// coordinate on the upper face stays in the last cell with fraction 1.
-fn interpolate(config: &HashGridConfig, l: usize, u: &[f64; 3], rows: &mut [i32], weights: &mut [f64]) {
-    let level = config.level(l);
+fn interpolate(level: &Level, u: &[f64; 3], rows: &mut [i32], weights: &mut [f64]) {
     let n = level.resolution as f64;
     let mut cell = [0u32; 3];
     let mut frac = [0f64; 3];
