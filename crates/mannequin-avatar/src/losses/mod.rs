@@ -1,0 +1,17 @@
+//! Training losses of Tavatar §4.3 as differentiable tensor functions: the photometric loss
+//! (Eqs. 12–13, built on [`ssim`]), and the mesh regularisers on a fixed topology: Laplacian
+//! smoothness and normal consistency (Eq. 15) and the equilateral term (Eq. 14).
+
+pub mod blur;
+mod equilateral;
+mod laplacian;
+mod normal_consistency;
+mod photometric;
+mod rows;
+mod ssim;
+mod topology;
+
+pub use blur::{BlurBackend, gaussian_blur_valid, gaussian_window};
+pub use photometric::{LAMBDA_SSIM, photometric};
+pub use ssim::{SsimBackend, ssim, ssim_map, ssim_with_blur};
+pub use topology::MeshTopology;
