@@ -74,16 +74,16 @@ pub fn sh_coefficients(
     match avatar.config.method {
         Method::Tavatar => {
             let degree = avatar.config.sh_degree;
-            let p = avatar
-                .params
-                .iter()
-                .find(|p| p.name == "sh")
-                .ok_or_else(|| AvatarError::Invalid("the Tavatar avatar has no 'sh' parameter".into()))?;
-            let coeffs: Vec<f32> = p.value.clone().into_data().iter::<f32>().collect();
+            let coeffs: Vec<f32> = avatar
+                .sh_coefficients()
+                .ok_or_else(|| AvatarError::Invalid("the Tavatar avatar has no SH coefficients".into()))?
+                .into_data()
+                .iter::<f32>()
+                .collect();
             let expected = gaussians.len() * 3 * sh::basis_len(degree);
             if coeffs.len() != expected {
                 return Err(AvatarError::Invalid(format!(
-                    "'sh' holds {} values, expected {expected} ({} Gaussians, degree {degree})",
+                    "{} SH values, expected {expected} ({} Gaussians, degree {degree})",
                     coeffs.len(),
                     gaussians.len()
                 )));
@@ -147,6 +147,15 @@ impl Binding {
     }
 }
 
+/// Running sums over a vertex's faces: Σ A·rgb, Σ A, Σ rgb and their count.
+#[derive(Clone, Copy, Default)]
+struct FaceSums {
+    weighted: [f64; 3],
+    area: f64,
+    plain: [f64; 3],
+    count: usize,
+}
+
 /// Per-vertex colour of the mesh (`vertices`, `faces`) from per-Gaussian colours `rgb` laid out by
 /// `binding`: a vertex takes its own vertex Gaussian's colour where it has one, else the
 /// area-weighted mean over its faces' Gaussians (a plain mean where all those faces are
@@ -175,8 +184,7 @@ pub fn bake_vertex_colours(
     if !binding.per_face {
         return Ok(vec![UNCOVERED; v]);
     }
-    // Per vertex: Σ A·rgb, Σ A, Σ rgb, count.
-    let mut weighted = vec![([0.0f64; 3], 0.0f64, [0.0f64; 3], 0usize); v];
+    let mut sums = vec![FaceSums::default(); v];
     for (face, colour) in faces.iter().zip(rgb) {
         let [a, b, c] = face.map(|i| vertices[i as usize].map(f64::from));
         let (e1, e2) = ([0, 1, 2].map(|k| b[k] - a[k]), [0, 1, 2].map(|k| c[k] - a[k]));
@@ -185,21 +193,21 @@ pub fn bake_vertex_colours(
         let area = 0.5 * cross.iter().map(|x| x * x).sum::<f64>().sqrt();
         let area = if area.is_finite() { area } else { 0.0 };
         for &i in face {
-            let acc = &mut weighted[i as usize];
-            for k in 0..3 {
-                acc.0[k] += area * f64::from(colour[k]);
-                acc.2[k] += f64::from(colour[k]);
+            let acc = &mut sums[i as usize];
+            for (k, &c) in colour.iter().enumerate() {
+                acc.weighted[k] += area * f64::from(c);
+                acc.plain[k] += f64::from(c);
             }
-            acc.1 += area;
-            acc.3 += 1;
+            acc.area += area;
+            acc.count += 1;
         }
     }
-    Ok(weighted
+    Ok(sums
         .iter()
-        .map(|&(sum, area, plain, count)| match (area > 0.0, count) {
+        .map(|s| match (s.area > 0.0, s.count) {
             (_, 0) => UNCOVERED,
-            (true, _) => sum.map(|s| (s / area) as f32),
-            (false, n) => plain.map(|s| (s / n as f64) as f32),
+            (true, _) => s.weighted.map(|x| (x / s.area) as f32),
+            (false, n) => s.plain.map(|x| (x / n as f64) as f32),
         })
         .collect())
 }
@@ -321,23 +329,24 @@ mod tests {
         config
     }
 
-    /// A tetrahedron avatar whose SH are `per_face` on face Gaussians and `per_vertex` on vertex
-    /// Gaussians (DC per channel; higher bases set to a nonzero filler).
+    /// A tetrahedron avatar whose DC terms are `per_face` on face Gaussians and `per_vertex` on
+    /// vertex Gaussians, with the higher bands set to a nonzero filler.
     fn tavatar(config: AvatarConfig, per_face: [f32; 3], per_vertex: [f32; 3]) -> Avatar {
         let device = Device::flex();
         let mut avatar = Avatar::new(config.clone(), tetrahedron(), &device).unwrap();
-        let k = sh::basis_len(config.sh_degree);
-        let coeffs = |dc: [f32; 3]| (0..3 * k).map(move |i| if i < 3 { dc[i] } else { 0.1 * i as f32 - 0.7 });
-        let mut values: Vec<f32> = Vec::new();
+        let mut dc: Vec<f32> = Vec::new();
         if config.face_gaussians {
-            values.extend((0..4).flat_map(|_| coeffs(per_face)));
+            dc.extend((0..4).flat_map(|_| per_face));
         }
         if config.vertex_gaussians {
-            values.extend((0..4).flat_map(|_| coeffs(per_vertex)));
+            dc.extend((0..4).flat_map(|_| per_vertex));
         }
-        let g = values.len() / (3 * k);
-        let sh = avatar.params.iter_mut().find(|p| p.name == "sh").unwrap();
-        sh.value = tensor_from(values, g, 3 * k, &device);
+        avatar.set_sh_dc(dc).unwrap();
+        if let Some(rest) = avatar.params.iter_mut().find(|p| p.name == "sh_rest") {
+            let [g, k] = rest.value.dims();
+            rest.value =
+                tensor_from((0..g * k).map(|i| 0.1 * (i % 13) as f32 - 0.6).collect(), g, k, &device);
+        }
         avatar
     }
 
@@ -399,6 +408,7 @@ mod tests {
     #[test]
     fn scene_reproduces_posed_gaussians() {
         let avatar = tavatar(small(Method::Tavatar), [0.3, -0.2, 0.5], [0.1, 0.4, -0.3]);
+        assert_eq!(avatar.config.sh_degree, 2);
         let posed = avatar.pose(&POSE, [0.2, -0.1, 0.3]).unwrap();
         let scene = gaussian_scene(&avatar, &posed.gaussians).unwrap();
         assert_eq!(scene.len(), avatar.num_gaussians());
@@ -414,15 +424,15 @@ mod tests {
                 }
             }
         }
-        let sh: Vec<f32> = avatar
-            .params
-            .iter()
-            .find(|p| p.name == "sh")
-            .unwrap()
-            .value
-            .clone()
-            .into_data()
-            .iter::<f32>()
+        // Basis-major: each Gaussian's DC triple, then its higher bands as the test set them.
+        let (face_dc, vertex_dc) = ([0.3, -0.2, 0.5], [0.1, 0.4, -0.3]);
+        let rest_len = 3 * (sh::basis_len(scene.sh_degree) - 1);
+        let sh: Vec<f32> = (0..8)
+            .flat_map(|g| {
+                let dc: [f32; 3] = if g < 4 { face_dc } else { vertex_dc };
+                let rest = (g * rest_len..(g + 1) * rest_len).map(|i| 0.1 * (i % 13) as f32 - 0.6);
+                dc.into_iter().chain(rest)
+            })
             .collect();
         assert_eq!(scene.sh, sh);
 

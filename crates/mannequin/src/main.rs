@@ -6,6 +6,7 @@ mod body;
 mod demo;
 mod eval;
 mod eval_avatar;
+mod export;
 mod motion;
 mod progress;
 mod render;
@@ -47,6 +48,9 @@ enum Command {
     Render(render::Args),
     /// Reconstruct an animatable avatar from a dataset (Tavatar or iHuman binding).
     Train(train::Args),
+    /// Export a trained avatar: its mesh (.obj/.ply, canonical or posed), a skinned coloured .glb,
+    /// or its Gaussians at a pose as a 3DGS .ply.
+    Export(export::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -62,6 +66,7 @@ fn main() -> std::process::ExitCode {
         Command::Splat(args) => splat::run(args),
         Command::Train(args) => train::run(args),
         Command::Render(args) => render::run(args),
+        Command::Export(args) => export::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,0 +1,134 @@
+//! `mannequin export`: a trained avatar as files other tools open: its personalised mesh
+//! (canonical or posed `.obj`/`.ply`), a skinned `.glb` with per-vertex colour baked from the
+//! Gaussians, and its Gaussians at any pose as a 3DGS `.ply`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use burn::tensor::Device;
+use mannequin_avatar::{Avatar, Posed, export};
+use mannequin_body::{Motion, named_pose};
+use mannequin_mesh::TriMesh;
+
+use crate::body::write_mesh;
+use crate::progress::JobTimer;
+
+#[derive(clap::Args)]
+#[command(group = clap::ArgGroup::new("outputs").required(true).multiple(true).args(["output", "gaussians"]))]
+pub struct Args {
+    /// Model folder written by `mannequin train`.
+    #[arg(long)]
+    model: PathBuf,
+    /// Pose: `canonical` (zero pose and translation: the personalised canonical mesh) or a named
+    /// SMPL pose (t-pose, a-pose, arms-raised, squat, walk, arms-crossed).
+    #[arg(long, visible_alias = "named", default_value = "canonical", conflicts_with = "motion")]
+    pose: String,
+    /// AMASS or PeopleSnapshot motion file: pose and translation of its frame --frame.
+    #[arg(long)]
+    motion: Option<PathBuf>,
+    /// Frame of --motion.
+    #[arg(long, default_value_t = 0, requires = "motion")]
+    frame: usize,
+    /// The mesh with vertex colour baked from the Gaussians, by extension: `.obj` or `.ply` at the
+    /// pose, or a skinned `.glb` (bind pose: the canonical mesh; COLOR_0; the avatar's skeleton
+    /// and weights; canonical pose only).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// The Gaussians at the pose as a 3DGS `.ply` in the INRIA layout, for splat viewers.
+    #[arg(long)]
+    gaussians: Option<PathBuf>,
+}
+
+impl Args {
+    /// The zero pose and translation, where the posed mesh is V_s itself.
+    fn canonical(&self) -> bool {
+        self.motion.is_none() && self.pose == "canonical"
+    }
+}
+
+/// Pose (3J values) and translation of the requested pose.
+fn chosen_pose(args: &Args, joints: usize) -> Result<(Vec<f32>, [f32; 3])> {
+    if let Some(path) = &args.motion {
+        let motion = Motion::read(path)?;
+        if args.frame >= motion.num_frames() {
+            bail!(
+                "{}: frame {} asked, the motion has {} frames",
+                path.display(),
+                args.frame,
+                motion.num_frames()
+            );
+        }
+        let poses = motion.poses_for_joints(joints)?;
+        let pose = poses[args.frame * 3 * joints..(args.frame + 1) * 3 * joints].to_vec();
+        let transl = [0, 1, 2].map(|k| motion.trans[3 * args.frame + k]);
+        return Ok((pose, transl));
+    }
+    if args.canonical() {
+        return Ok((vec![0.0; 3 * joints], [0.0; 3]));
+    }
+    let pose = named_pose(&args.pose)?;
+    if joints != pose.len() / 3 {
+        bail!("named poses are SMPL (24-joint) poses; this avatar has {joints} joints");
+    }
+    Ok((pose.to_vec(), [0.0; 3]))
+}
+
+fn host_rows(t: &burn::tensor::Tensor<2>) -> Vec<[f32; 3]> {
+    let flat: Vec<f32> = t.clone().into_data().iter::<f32>().collect();
+    flat.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect()
+}
+
+/// Whether `-o` names a skinned `.glb` (else `.obj` or `.ply`; anything else is an error).
+fn is_glb(path: &Path) -> Result<bool> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("glb") => Ok(true),
+        Some("obj" | "ply") => Ok(false),
+        _ => bail!("{}: unknown mesh format; expected a .obj, .ply or .glb extension", path.display()),
+    }
+}
+
+/// Writes the mesh: skinned `.glb` at the bind pose, or `.obj`/`.ply` at the pose (V_s exactly
+/// when `canonical`); each with vertex colour baked from the Gaussians.
+fn write_output(avatar: &Avatar, posed: &Posed, canonical: bool, glb: bool, output: &Path) -> Result<()> {
+    if glb {
+        let skinned = export::skinned_mesh(avatar, posed)?;
+        return mannequin_mesh::gltf::write_glb(output, &skinned, None)
+            .with_context(|| format!("writing {}", output.display()));
+    }
+    let vertices = if canonical { &posed.personalised } else { &posed.vertices };
+    let mut mesh = TriMesh::new(host_rows(vertices), avatar.canonical.faces.clone());
+    mesh.colors = Some(export::vertex_colours(avatar, posed)?);
+    write_mesh(output, &mesh)
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let _timer = JobTimer::start("export");
+    // Every argument is checked before the model loads.
+    let glb = args.output.as_deref().map(is_glb).transpose()?;
+    if let (Some(true), Some(output)) = (glb, &args.output)
+        && !args.canonical()
+    {
+        bail!(
+            "{}: a .glb is written at its bind pose (the canonical mesh); drop --pose/--motion, or write .obj/.ply",
+            output.display()
+        );
+    }
+    if let Some(path) =
+        args.gaussians.as_deref().filter(|p| !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
+    {
+        bail!("{}: Gaussians are written as a 3DGS .ply; use a .ply extension", path.display());
+    }
+    let avatar = Avatar::load(&args.model, &Device::flex())?;
+    let (pose, transl) = chosen_pose(&args, avatar.canonical.num_joints())?;
+    let posed = avatar.pose(&pose, transl)?;
+    if let (Some(output), Some(glb)) = (&args.output, glb) {
+        write_output(&avatar, &posed, args.canonical(), glb, output)?;
+        println!("wrote {} ({} vertices)", output.display(), avatar.canonical.num_vertices());
+    }
+    if let Some(path) = &args.gaussians {
+        let scene = export::gaussian_scene(&avatar, &posed.gaussians)?;
+        scene.write_ply(path)?;
+        println!("wrote {} ({} Gaussians, SH degree {})", path.display(), scene.len(), scene.sh_degree);
+    }
+    Ok(())
+}

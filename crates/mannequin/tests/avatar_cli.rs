@@ -1,0 +1,314 @@
+//! The avatar verbs as a user runs them, on a tiny synthetic subject trained for three
+//! iterations: `export` (meshes, skinned glTF, 3DGS splats) and `animate --avatar`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+use burn::tensor::Device;
+use mannequin_avatar::Avatar;
+use mannequin_body::named_pose;
+use mannequin_splat::SplatScene;
+
+fn mannequin(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap()
+}
+
+fn ok(o: Output) -> Output {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Scratch folder `name`, emptied.
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("avatar-cli-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// One model folder for every test: synthesised and trained once (a few seconds).
+fn model() -> &'static Path {
+    static MODEL: OnceLock<PathBuf> = OnceLock::new();
+    MODEL.get_or_init(|| {
+        let dir = scratch("model");
+        let (data, model) = (dir.join("data"), dir.join("model"));
+        ok(mannequin(&[
+            "synth",
+            "--seed",
+            "1",
+            "--size",
+            "96",
+            "--frames",
+            "10",
+            "--train",
+            "8",
+            "--model",
+            "default-lod1",
+            "--out",
+            s(&data),
+        ]));
+        ok(mannequin(&[
+            "train",
+            "--data",
+            s(&data),
+            "--out",
+            s(&model),
+            "--iters",
+            "3",
+            "--checkpoint-every",
+            "3",
+            "--model",
+            "default-lod1",
+        ]));
+        ok(mannequin(&["motion", "walk", "--seconds", "1", "-o", s(&dir.join("walk.npz"))]));
+        model
+    })
+}
+
+fn walk() -> PathBuf {
+    model().parent().unwrap().join("walk.npz")
+}
+
+fn close(a: &[f32], b: &[f32], tol: f32, what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths");
+    let worst = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);
+    assert!(worst <= tol, "{what}: differ by {worst}");
+}
+
+fn host(t: burn::tensor::Tensor<2>) -> Vec<f32> {
+    t.into_data().iter::<f32>().collect()
+}
+
+/// Width and height from a PNG's IHDR chunk.
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(&bytes[1..4], b"PNG", "{}", path.display());
+    let be = |at: usize| u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+/// Runs the Khronos validator (tools/gltf_validate.mjs) as crates/mannequin-mesh's glTF tests
+/// do; without it installed this says so and passes, unless MANNEQUIN_REQUIRE_GLTF_VALIDATOR=1.
+fn validate_gltf(path: &Path) {
+    let dir = std::env::var_os("GLTF_VALIDATOR_DIR").map(PathBuf::from).unwrap_or_else(|| {
+        PathBuf::from(std::env::var_os("HOME").unwrap_or_default())
+            .join(".cache/gltf-validator/node_modules/gltf-validator")
+    });
+    let node_ok = Command::new("node").arg("--version").output().is_ok_and(|o| o.status.success());
+    if !(dir.join("package.json").exists() && node_ok) {
+        let message = format!("glTF validator not found at {} (or node missing)", dir.display());
+        assert!(std::env::var("MANNEQUIN_REQUIRE_GLTF_VALIDATOR").as_deref() != Ok("1"), "{message}");
+        eprintln!("SKIPPED: {message}");
+        return;
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf_validate.mjs");
+    let out = Command::new("node").arg(&script).arg(path).env("GLTF_VALIDATOR_DIR", &dir).output().unwrap();
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && report.contains(" 0 errors"), "validator:\n{report}");
+}
+
+#[test]
+fn export_writes_meshes_glb_and_splats() {
+    let out = scratch("export");
+    let avatar = Avatar::load(model(), &Device::flex()).unwrap();
+    let v = avatar.canonical.num_vertices();
+
+    // Canonical OBJ: V_s itself, with a colour per vertex.
+    let obj = out.join("canonical.obj");
+    ok(mannequin(&["export", "--model", s(model()), "-o", s(&obj)]));
+    let mesh = mannequin_mesh::obj::read_obj(&obj).unwrap();
+    assert_eq!(mesh.vertex_count(), v);
+    let canonical = avatar.pose(&[0.0; 72], [0.0; 3]).unwrap();
+    close(&mesh.positions.concat(), &host(canonical.personalised), 1e-6, "canonical vertices");
+    assert!(
+        mesh.colors
+            .as_ref()
+            .is_some_and(|c| c.len() == v && c.concat().iter().all(|x| (0.0..=1.0).contains(x)))
+    );
+
+    // Posed PLY at a named pose.
+    let ply = out.join("squat.ply");
+    ok(mannequin(&["export", "--model", s(model()), "--named", "squat", "-o", s(&ply)]));
+    let posed_mesh = mannequin_mesh::ply::read(&ply).unwrap().mesh;
+    let squat = avatar.pose_mesh(&named_pose("squat").unwrap(), [0.0; 3]).unwrap();
+    close(&posed_mesh.positions.concat(), &squat.concat(), 1e-5, "squat vertices");
+
+    // Skinned glTF.
+    let glb = out.join("avatar.glb");
+    ok(mannequin(&["export", "--model", s(model()), "-o", s(&glb)]));
+    assert_eq!(&std::fs::read(&glb).unwrap()[..4], b"glTF");
+    validate_gltf(&glb);
+
+    // 3DGS splats at a motion frame: the avatar's posed Gaussians.
+    let splats = out.join("splats.ply");
+    ok(mannequin(&[
+        "export",
+        "--model",
+        s(model()),
+        "--motion",
+        s(&walk()),
+        "--frame",
+        "7",
+        "--gaussians",
+        s(&splats),
+    ]));
+    let scene = SplatScene::read_ply(&splats).unwrap();
+    assert_eq!(scene.len(), avatar.num_gaussians());
+    let motion = mannequin_body::Motion::read(&walk()).unwrap();
+    let pose = &motion.poses_for_joints(24).unwrap()[7 * 72..8 * 72];
+    let transl = [0, 1, 2].map(|k| motion.trans[21 + k]);
+    let posed = avatar.pose(pose, transl).unwrap();
+    close(&scene.means, &host(posed.gaussians.means), 1e-5, "Gaussian means");
+    assert!(scene.opacities.iter().all(|&o| o > 0.9999));
+
+    // A splat viewer sees what the avatar renders: the file through `splat render` and the avatar
+    // through `render`, same frame and camera (white background), give the same 8-bit image.
+    let camera = out.join("camera.json");
+    std::fs::write(
+        &camera,
+        r#"{"K": [[240, 0, 64], [0, 240, 48], [0, 0, 1]], "extrinsic": [[1, 0, 0, 0], [0, -1, 0, 0.2],
+            [0, 0, -1, 3.2], [0, 0, 0, 1]], "width": 128, "height": 96, "background": [1, 1, 1]}"#,
+    )
+    .unwrap();
+    let (from_file, from_avatar) = (out.join("file.png"), out.join("avatar.png"));
+    ok(mannequin(&["splat", "render", "--ply", s(&splats), "--camera", s(&camera), "-o", s(&from_file)]));
+    ok(mannequin(&[
+        "render",
+        "--model",
+        s(model()),
+        "--motion",
+        s(&walk()),
+        "--frame",
+        "7",
+        "--camera",
+        s(&camera),
+        "-o",
+        s(&from_avatar),
+    ]));
+    let a = mannequin_data::Image::read_png(&from_file).unwrap();
+    let b = mannequin_data::Image::read_png(&from_avatar).unwrap();
+    assert!(a.pixels.iter().any(|p| p[0] < 0.9), "the body is in view");
+    close(&a.pixels.concat(), &b.pixels.concat(), 2.0 / 255.0, "splat file vs avatar render");
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// A stand-in `ffmpeg` that records its arguments and writes its output file (the last one).
+fn fake_ffmpeg(dir: &Path) {
+    use std::os::unix::fs::PermissionsExt;
+    let script = dir.join("ffmpeg");
+    // Shell built-ins only: PATH holds nothing else.
+    let body =
+        "#!/bin/sh\necho \"$@\" > \"${0%/*}/args.txt\"\nfor last; do :; done\necho video > \"$last\"\n";
+    std::fs::write(&script, body).unwrap();
+    std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+}
+
+#[test]
+fn animate_renders_frames_and_video() {
+    let out = scratch("animate");
+    let frames = out.join("frames");
+    let no_tools = out.join("empty-path");
+    std::fs::create_dir_all(&no_tools).unwrap();
+    let walk = walk();
+    let run = |extra: &[&str], path: &Path| {
+        let mut args = vec![
+            "animate",
+            "--avatar",
+            s(model()),
+            "--motion",
+            s(&walk),
+            "--max-frames",
+            "3",
+            "-o",
+            s(&frames),
+        ];
+        args.extend_from_slice(extra);
+        ok(Command::new(env!("CARGO_BIN_EXE_mannequin")).args(&args).env("PATH", path).output().unwrap())
+    };
+    // No ffmpeg: frames at the front camera's size, and one line saying why there is no video.
+    let o = run(&[], &no_tools);
+    for f in 0..3 {
+        assert_eq!(png_size(&frames.join(format!("frame_{f:04}.png"))), (540, 540));
+    }
+    assert!(!frames.join("frame_0003.png").exists(), "--max-frames 3");
+    assert!(!frames.join("animation.mp4").exists());
+    let log = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        log.lines().filter(|l| l.contains("no video written") && l.contains("ffmpeg")).count(),
+        1,
+        "{log}"
+    );
+
+    // A camera file sets the size; with ffmpeg on PATH the video is encoded as H.264 yuv420p.
+    let camera = out.join("camera.json");
+    std::fs::write(
+        &camera,
+        r#"{"K": [[200, 0, 40], [0, 200, 30], [0, 0, 1]], "extrinsic": [[1, 0, 0, 0], [0, -1, 0, 0.2],
+            [0, 0, -1, 4], [0, 0, 0, 1]], "width": 80, "height": 60}"#,
+    )
+    .unwrap();
+    let tools = out.join("tools");
+    std::fs::create_dir_all(&tools).unwrap();
+    fake_ffmpeg(&tools);
+    run(&["--camera", s(&camera), "--what", "normals"], &tools);
+    assert_eq!(png_size(&frames.join("frame_0002.png")), (80, 60));
+    let args = std::fs::read_to_string(tools.join("args.txt")).unwrap();
+    for needed in ["libx264", "yuv420p", "frame_%04d.png", "-frames:v 3"] {
+        assert!(args.contains(needed), "'{needed}' not in ffmpeg arguments: {args}");
+    }
+    assert!(frames.join("animation.mp4").exists());
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+fn one_line_error(o: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let line =
+        err.lines().find(|l| l.starts_with("error:")).unwrap_or_else(|| panic!("no error line in {err}"));
+    for n in needles {
+        assert!(line.contains(n), "'{n}' not in: {line}");
+    }
+}
+
+#[test]
+fn bad_inputs_give_one_line_errors() {
+    let out = scratch("bad");
+    let missing = out.join("no_such_model");
+    let obj = out.join("x.obj");
+    one_line_error(&mannequin(&["export", "--model", s(&missing), "-o", s(&obj)]), &["no_such_model"]);
+    one_line_error(
+        &mannequin(&["animate", "--avatar", s(&missing), "--motion", s(&walk()), "-o", s(&out)]),
+        &["no_such_model"],
+    );
+    one_line_error(
+        &mannequin(&["export", "--model", s(model()), "--named", "cartwheel", "-o", s(&obj)]),
+        &["cartwheel"],
+    );
+    one_line_error(
+        &mannequin(&["export", "--model", s(model()), "--named", "squat", "-o", s(&out.join("a.glb"))]),
+        &["a.glb", "bind pose"],
+    );
+    one_line_error(&mannequin(&["export", "--model", s(model()), "-o", s(&out.join("a.fbx"))]), &["a.fbx"]);
+    assert!(!obj.exists());
+    // Avatar and body modes are exclusive, as clap reports usage errors (exit code 2).
+    let o = mannequin(&[
+        "animate",
+        "--avatar",
+        s(model()),
+        "--model",
+        "default",
+        "--motion",
+        s(&walk()),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
+    std::fs::remove_dir_all(out).unwrap();
+}
