@@ -34,8 +34,10 @@ pub const PARAMS_FILE: &str = "avatar.npz";
 /// The learned parts that are not fields, by index into `Avatar::params`.
 #[derive(Clone, Debug, Default)]
 struct Slots {
-    /// Tavatar: SH coefficients [G, 3(d+1)²], basis-major.
-    sh: Option<usize>,
+    /// Tavatar: SH colour, the DC term [G, 3] and the higher bands [G, 3((d+1)² − 1)],
+    /// basis-major.
+    sh_dc: Option<usize>,
+    sh_rest: Option<usize>,
     /// Tavatar w/o FG: log in-plane scales of vertex Gaussians [V, 2].
     vertex_log_scales: Option<usize>,
     /// iHuman: log in-plane scales (s2, s3) [F, 2], in-plane rotation (x, y) [F, 2], joints [J, 3].
@@ -105,9 +107,16 @@ impl Avatar {
         match config.method {
             Method::Tavatar => {
                 let g = usize::from(config.face_gaussians) * f + usize::from(config.vertex_gaussians) * v;
-                let k = 3 * sh::basis_len(config.sh_degree);
-                params.push(Param::new("sh", tensor_from(vec![0.0; g * k], g, k, device), COLOUR_LR));
-                slots.sh = Some(params.len() - 1);
+                params.push(Param::new("sh_dc", tensor_from(vec![0.0; g * 3], g, 3, device), COLOUR_LR));
+                slots.sh_dc = Some(params.len() - 1);
+                let k = 3 * (sh::basis_len(config.sh_degree) - 1);
+                if k > 0 {
+                    // 3DGS's rates: the view-dependent bands learn 20× slower than the DC term, so
+                    // colour is explained view-independently first and novel views stay sane.
+                    let lr = COLOUR_LR / 20.0;
+                    params.push(Param::new("sh_rest", tensor_from(vec![0.0; g * k], g, k, device), lr));
+                    slots.sh_rest = Some(params.len() - 1);
+                }
                 if !config.face_gaussians {
                     let init = ihuman::log_edge_scales(&canonical);
                     params.push(Param::new("vertex_log_scales", tensor_from(init, v, 2, device), 1e-3));
@@ -260,11 +269,31 @@ impl Avatar {
         }
     }
 
+    /// Replaces Tavatar's DC colour coefficients [G · 3]; iHuman's colour field is left alone.
+    pub fn set_sh_dc(&mut self, values: Vec<f32>) -> Result<(), AvatarError> {
+        let Some(i) = self.slots.sh_dc else { return Ok(()) };
+        let g = self.num_gaussians();
+        if values.len() != 3 * g {
+            return Err(AvatarError::Invalid(format!("{} DC values for {g} Gaussians", values.len())));
+        }
+        self.params[i].value = crate::params::trainable(tensor_from(values, g, 3, &self.device));
+        Ok(())
+    }
+
+    /// Tavatar's SH coefficients [G, 3(d+1)²], basis-major (DC first); `None` for iHuman.
+    pub fn sh_coefficients(&self) -> Option<Tensor<2>> {
+        let dc = self.param(self.slots.sh_dc)?;
+        Some(match self.param(self.slots.sh_rest) {
+            Some(rest) => Tensor::cat(vec![dc, rest], 1),
+            None => dc,
+        })
+    }
+
     /// Per-Gaussian RGB [G, 3] seen from `eye` (view-dependent through the SH).
     pub fn colours(&self, gaussians: &GaussianGeometry, eye: [f64; 3]) -> Result<Tensor<2>, AvatarError> {
         let rgb = match self.config.method {
             Method::Tavatar => {
-                let coeffs = self.param(self.slots.sh).expect("Tavatar has SH");
+                let coeffs = self.sh_coefficients().expect("Tavatar has SH");
                 let g = gaussians.len();
                 let k = sh::basis_len(self.config.sh_degree);
                 let eye = Tensor::<2>::from_data(

@@ -5,6 +5,7 @@
 pub mod adam;
 pub mod avatar;
 pub mod canonical;
+pub mod colour_init;
 pub mod config;
 pub mod error;
 pub mod export;

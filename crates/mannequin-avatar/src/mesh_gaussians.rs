@@ -170,12 +170,18 @@ pub fn vertex_gaussians(vertices: &Tensor<2>, index: &MeshIndex) -> GaussianGeom
     let r: Tensor<2> = axis.one_hot::<2>(3).float().cast(n.dtype());
     let t1 = normalise(r.cross(n.clone(), 1));
     let t2 = n.clone().cross(t1.clone(), 1);
-    // Eq. 11: γ times the shortest one-ring edge; padding entries are lifted out of the min.
+    // Eq. 11: γ times the shortest one-ring edge. The nearest neighbour is found on detached
+    // values (padding lifted out of the min), then that one edge is measured again with a plain
+    // gather, so the gradient reaches exactly the two vertices of the shortest edge.
     let v = index.num_vertices;
-    let neighbours = vertices.clone().select(0, index.ring.clone()).reshape([v, index.valence, 3]);
-    let offsets = neighbours - vertices.clone().unsqueeze_dim::<3>(1);
-    let lengths = (offsets.square().sum_dim(2) + NORM_EPS).sqrt().reshape([v, index.valence]);
-    let shortest = (lengths + index.ring_pad.clone().cast(n.dtype()) * 1e6).min_dim(1);
+    let neighbours = vertices.clone().detach().select(0, index.ring.clone()).reshape([v, index.valence, 3]);
+    let offsets = neighbours - vertices.clone().detach().unsqueeze_dim::<3>(1);
+    let lengths = offsets.square().sum_dim(2).reshape([v, index.valence]);
+    let padded = lengths + index.ring_pad.clone().cast(n.dtype()) * 1e6;
+    let slot = padded.argmin(1).reshape([v]);
+    let rows = Tensor::<1, Int>::arange(0..v as i64, &vertices.device()) * index.valence as i64;
+    let nearest = index.ring.clone().select(0, rows + slot);
+    let shortest = row_norm(vertices.clone().select(0, nearest) - vertices.clone());
     GaussianGeometry {
         means: vertices.clone(),
         frames: frame(t1, t2, n.clone()),

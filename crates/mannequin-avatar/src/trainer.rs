@@ -124,6 +124,9 @@ impl Trainer {
         }
         let topology =
             MeshTopology::new(avatar.canonical.num_vertices(), &avatar.canonical.faces, avatar.device())?;
+        let mut avatar = avatar;
+        let colours = crate::colour_init::observed_colours(&avatar, &views)?;
+        avatar.set_sh_dc(crate::colour_init::dc_coefficients(&colours))?;
         let adam = Adam::new(&avatar.params);
         let laplacian_scale = mean_edge_length(&avatar.canonical).max(1e-6).powi(-2);
         Ok(Self { avatar, options, iteration: 0, adam, views, topology, laplacian_scale })
