@@ -1,51 +1,80 @@
-//! `mannequin demo`: the README's main job on the embedded default body. It poses the body in
-//! the named poses, writes a procedural walk as AMASS `.npz`, and exports that walk as a skinned,
-//! animated `.glb`, all under one folder, with one progress display.
+//! `mannequin demo`: the README's main job on the embedded default body. It makes a synthetic
+//! clothed subject, trains a Tavatar avatar on it, evaluates it on novel views and poses,
+//! animates it with a walk, and exports it (skinned .glb, 3DGS .ply, posed .obj), all under one
+//! folder. Each stage runs the same code as its own verb; one progress bar at a time shows the
+//! stage it belongs to.
 
 use std::path::PathBuf;
 
-use anyhow::Result;
-use clap::Args as ClapArgs;
-use mannequin_body::{BodyModel, Motion, POSE_NAMES, forward, named_pose, skeletal_animation, skinned_body};
+use anyhow::{Context, Result};
+use clap::{Args as ClapArgs, Parser};
 
-use crate::body::write_mesh;
-use crate::progress::{JobTimer, bar};
+use crate::progress::{JobTimer, set_stage};
 
 #[derive(ClapArgs)]
 pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out/demo")]
     out: PathBuf,
-    /// Shape coefficients of the default body, comma-separated.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_value = "0")]
-    betas: Vec<f32>,
+    /// Seed of the synthetic subject and of training.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Training iterations.
+    #[arg(long, default_value_t = 2000)]
+    iters: usize,
+    /// Image size of the synthetic subject.
+    #[arg(long, default_value_t = 540)]
+    size: usize,
+    /// Frames of the walk animation.
+    #[arg(long, default_value_t = 60)]
+    walk_frames: usize,
 }
 
 pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("demo");
-    let model = BodyModel::default_body();
-    let progress = bar(POSE_NAMES.len() as u64 + 2, "demo");
-    for name in POSE_NAMES {
-        let posed = forward(&model, &args.betas, &named_pose(name)?, &[0.0; 3])?;
-        let mut mesh = model.template_mesh();
-        mesh.positions = posed.frame_vertices(0).chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
-        write_mesh(&args.out.join("poses").join(format!("{name}.obj")), &mesh)?;
-        progress.inc(1);
+    let path = |p: &str| args.out.join(p).to_string_lossy().into_owned();
+    let (seed, iters, size, frames) =
+        (args.seed.to_string(), args.iters.to_string(), args.size.to_string(), args.walk_frames.to_string());
+    let (subject, avatar, walk) = (path("subject"), path("avatar"), path("walk.npz"));
+    let (eval_json, walk_dir) = (path("eval.json"), path("walk"));
+    let (glb, splats, squat) = (path("avatar.glb"), path("avatar_gaussians.ply"), path("avatar_squat.obj"));
+    let stages: Vec<(&str, Vec<&str>)> = vec![
+        ("subject", vec!["synth", "--seed", &seed, "--size", &size, "--out", &subject]),
+        (
+            "train",
+            vec![
+                "train",
+                "--data",
+                &subject,
+                "--out",
+                &avatar,
+                "--iters",
+                &iters,
+                "--seed",
+                &seed,
+                "--restart",
+            ],
+        ),
+        ("evaluate", vec!["eval", "--model", &avatar, "--data", &subject, "--json", &eval_json]),
+        ("motion", vec!["motion", "walk", "-o", &walk]),
+        (
+            "animate",
+            vec!["animate", "--avatar", &avatar, "--motion", &walk, "--max-frames", &frames, "-o", &walk_dir],
+        ),
+        ("export", vec!["export", "--model", &avatar, "-o", &glb, "--gaussians", &splats]),
+        ("export", vec!["export", "--model", &avatar, "--pose", "squat", "-o", &squat]),
+    ];
+    let count = stages.len();
+    for (i, (name, argv)) in stages.into_iter().enumerate() {
+        set_stage(&format!("{}/{count} {name}", i + 1));
+        let cli = crate::Cli::try_parse_from(std::iter::once("mannequin").chain(argv))
+            .with_context(|| format!("demo stage {name}"))?;
+        crate::dispatch(cli.command).with_context(|| format!("demo stage {name}"))?;
     }
-    let walk = Motion::walk_cycle(4.0, 30.0);
-    let walk_path = args.out.join("walk.npz");
-    walk.write_amass(&walk_path)?;
-    progress.inc(1);
-    let glb = args.out.join("walk.glb");
-    let animation = skeletal_animation(&model, &walk.poses_for(&model)?, &walk.trans, walk.fps)?;
-    mannequin_mesh::gltf::write_glb(&glb, &skinned_body(&model, &args.betas)?, Some(&animation))?;
-    progress.finish_and_clear();
-    tracing::info!(
-        "wrote {}/poses/*.obj ({} poses), {} and {}",
-        args.out.display(),
-        POSE_NAMES.len(),
-        walk_path.display(),
-        glb.display()
+    set_stage("");
+    println!(
+        "demo done: {}/avatar (model), eval.json, walk/ (frames), avatar.glb, avatar_gaussians.ply, avatar_squat.obj",
+        args.out.display()
     );
     Ok(())
 }

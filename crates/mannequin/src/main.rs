@@ -36,7 +36,8 @@ enum Command {
     Motion(motion::MotionCommand),
     /// Drive a body with an AMASS or PeopleSnapshot motion and write a skinned, animated .glb.
     Animate(animate::Args),
-    /// The main job on the embedded default body: pose, animate and export, under one folder.
+    /// The main job on the embedded default body: synthetic subject, training, evaluation,
+    /// animation and export, under one folder.
     Demo(demo::Args),
     /// Compare predictions with a ground-truth dataset: PSNR, SSIM, LPIPS, normal and geometry errors.
     Eval(eval::Args),
@@ -53,10 +54,9 @@ enum Command {
     Export(export::Args),
 }
 
-fn main() -> std::process::ExitCode {
-    let cli = Cli::parse();
-    progress::init_logging(cli.verbose);
-    let result: anyhow::Result<()> = match cli.command {
+/// Runs one verb; the demo chains several through here.
+fn dispatch(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Body(cmd) => body::run(cmd),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
@@ -67,8 +67,13 @@ fn main() -> std::process::ExitCode {
         Command::Train(args) => train::run(args),
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
-    };
-    match result {
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    progress::init_logging(cli.verbose);
+    match dispatch(cli.command) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             // One readable line: the chain of causes, outermost first.

@@ -1,6 +1,7 @@
 //! Logging and progress display shared by every verb: `tracing` for logs, `indicatif` for bars,
 //! and a closing line with wall time and peak memory for long jobs.
 
+use std::sync::Mutex;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -21,13 +22,25 @@ pub fn init_logging(verbose: u8) {
         .init();
 }
 
-/// A progress bar for `len` steps of work, labelled `what`.
+/// The stage of a multi-stage job (the demo), shown before every bar.
+static STAGE: Mutex<String> = Mutex::new(String::new());
+
+/// Labels the bars that follow with `stage` ("" for none).
+pub fn set_stage(stage: &str) {
+    *STAGE.lock().unwrap_or_else(|e| e.into_inner()) = stage.to_string();
+}
+
+/// A progress bar for `len` steps of work, labelled `what` (and the current stage, if any).
 pub fn bar(len: u64, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
+    let stage = STAGE.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    let prefix = if stage.is_empty() { String::new() } else { format!("[{stage}] ") };
     bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} {per_sec} eta {eta}")
-            .expect("static template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(&format!(
+            "{prefix}{{msg:>12}} [{{bar:30}}] {{pos}}/{{len}} {{per_sec}} eta {{eta}}"
+        ))
+        .expect("valid template")
+        .progress_chars("=> "),
     );
     bar.set_message(what.to_string());
     bar

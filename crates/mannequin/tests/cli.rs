@@ -15,16 +15,39 @@ fn temp(name: &str) -> PathBuf {
 }
 
 #[test]
-fn demo_writes_meshes_motion_and_glb() {
+fn demo_trains_evaluates_animates_and_exports() {
     let out = temp("demo");
-    let o = mannequin(&["demo", "--out", out.to_str().unwrap()]);
+    // A short, small run of the README's main job: every stage, every output.
+    let o = mannequin(&[
+        "demo",
+        "--out",
+        out.to_str().unwrap(),
+        "--iters",
+        "4",
+        "--size",
+        "96",
+        "--walk-frames",
+        "3",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["walk.npz", "walk.glb", "poses/squat.obj", "poses/arms-raised.obj"] {
-        assert!(out.join(f).metadata().is_ok_and(|m| m.len() > 1000), "{f} missing");
+    for f in [
+        "walk.npz",
+        "avatar.glb",
+        "avatar_gaussians.ply",
+        "avatar_squat.obj",
+        "eval.json",
+        "walk/frame_0002.png",
+    ] {
+        assert!(out.join(f).metadata().is_ok_and(|m| m.len() > 200), "{f} missing");
     }
-    let glb = std::fs::read(out.join("walk.glb")).unwrap();
-    assert_eq!(&glb[..4], b"glTF");
-    // The walk written by the demo animates through the animate verb too, resampled.
+    let scores: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("eval.json")).unwrap()).unwrap();
+    for key in ["novel_view", "novel_pose", "geometry"] {
+        assert!(scores.get(key).is_some(), "eval.json lacks {key}: {scores}");
+    }
+    assert!(scores["novel_view"]["psnr"].as_f64().is_some_and(f64::is_finite));
+    assert!(scores["geometry"]["chamfer_cm"].as_f64().is_some_and(|c| c > 0.0));
+    // The walk written by the demo drives the plain body through the animate verb too.
     let again = out.join("again.glb");
     let walk = out.join("walk.npz");
     let o = mannequin(&[
@@ -39,6 +62,7 @@ fn demo_writes_meshes_motion_and_glb() {
         again.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(&std::fs::read(&again).unwrap()[..4], b"glTF");
     std::fs::remove_dir_all(out).unwrap();
 }
 
