@@ -8,6 +8,7 @@ pub mod canonical;
 pub mod colour_init;
 pub mod config;
 pub mod error;
+pub mod evaluation;
 pub mod export;
 pub mod field;
 pub mod hash_grid;

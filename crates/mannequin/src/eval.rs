@@ -8,7 +8,7 @@ use anyhow::Context;
 use mannequin_data::evaluation::{EvalOptions, EvalSummary, FrameScores, evaluate, matching_frames};
 use mannequin_data::metrics::lpips::Lpips;
 
-use crate::eval_avatar::{evaluate_avatar, print_scores};
+use crate::eval_avatar::{evaluate_with_progress, print_scores};
 use crate::progress::{JobTimer, bar};
 
 #[derive(clap::Args)]
@@ -118,7 +118,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let options = EvalOptions { background, lpips, samples: args.samples, seed: args.seed };
     let text = match (&args.model, &args.data, &args.pred, &args.gt) {
         (Some(model), Some(data), _, _) => {
-            let scores = evaluate_avatar(model, data, &options)?;
+            let scores = evaluate_with_progress(model, data, &options)?;
             print_scores(&scores);
             serde_json::to_string_pretty(&scores)?
         }

@@ -160,7 +160,6 @@ impl HashGridBackend for Flex {
         let [grad, touched, offsets, pairs, weights] =
             [grad, touched, offsets, grouped_pairs, grouped_weights].map(contiguous);
         let f = grad.shape()[1];
-        let t0 = std::time::Instant::now();
         let data = with_types!(grad.dtype(), f, T, F => {
             let groups = Groups {
                 touched: ints(&touched),
@@ -171,7 +170,6 @@ impl HashGridBackend for Flex {
             let grad = grad.as_slice::<T>().expect(LAYOUT);
             TensorData::new(backward::<T, F>(grad, &groups, table_rows), vec![table_rows, f])
         });
-        eprintln!("bwd {:.2}", t0.elapsed().as_secs_f64() * 1e3);
         FlexTensor::from_data(data)
     }
 }
