@@ -86,6 +86,9 @@ fn run(
     (scores, per_iter)
 }
 
+/// Switches one component off.
+type Ablation = fn(&mut AvatarConfig, &mut TrainOptions);
+
 fn row(what: &str, value: f64, target: &str, met: bool) {
     println!("  {what:<34} {value:>9.3}   {target:<10} {}", if met { "met" } else { "NOT met" });
 }
@@ -124,7 +127,7 @@ fn main() {
 
     if ablations {
         let mut results = vec![("Full", g.normal_mse_x1e3.unwrap_or(f64::NAN), chamfer)];
-        let variants: [(&str, fn(&mut AvatarConfig, &mut TrainOptions)); 3] = [
+        let variants: [(&str, Ablation); 3] = [
             ("w/o FG", |c, _| c.face_gaussians = false),
             ("w/o VG", |c, _| c.vertex_gaussians = false),
             ("w/o ER", |_, o| o.lambda_equilateral = 0.0),

@@ -61,8 +61,8 @@ pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f
             if view.mask[q] < 0.5 {
                 continue;
             }
-            for ch in 0..3 {
-                sum[i][ch] += view.rgb[ch * n + q] as f64;
+            for (ch, acc) in sum[i].iter_mut().enumerate() {
+                *acc += view.rgb[ch * n + q] as f64;
             }
             count[i] += 1;
         }

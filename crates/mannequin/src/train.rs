@@ -55,27 +55,6 @@ pub struct Args {
     pub restart: bool,
 }
 
-impl Args {
-    /// Training arguments with defaults for everything but the paths.
-    pub fn new(data: PathBuf, out: PathBuf) -> Self {
-        Self {
-            data,
-            out,
-            method: Method::Tavatar,
-            iters: 2000,
-            seed: 0,
-            model: "default".into(),
-            subdivide: 0,
-            downscale: 1,
-            checkpoint_every: 200,
-            no_face_gaussians: false,
-            no_vertex_gaussians: false,
-            no_equilateral: false,
-            restart: false,
-        }
-    }
-}
-
 fn avatar_config(args: &Args) -> AvatarConfig {
     let mut config = AvatarConfig::new(args.method, args.seed);
     config.subdivisions = args.subdivide;
@@ -130,15 +109,14 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
     let config = avatar_config(args);
     let checkpoint = checkpoint_path(&args.out);
     let resume = !args.restart && checkpoint.exists();
-    if resume {
-        if let Some(saved) = saved_config(&args.out)?
-            && saved != config
-        {
-            bail!(
-                "{} holds a checkpoint of a different avatar configuration; use --restart to start over or another --out",
-                args.out.display()
-            );
-        }
+    if resume
+        && let Some(saved) = saved_config(&args.out)?
+        && saved != config
+    {
+        bail!(
+            "{} holds a checkpoint of a different avatar configuration; use --restart to start over or another --out",
+            args.out.display()
+        );
     }
     let canonical = Canonical::from_body(&model, &split.poses.betas, args.subdivide)?;
     let device = burn::tensor::Device::flex().autodiff();
