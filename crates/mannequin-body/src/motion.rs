@@ -164,6 +164,21 @@ impl Motion {
         self.poses_for_joints(model.num_joints())
     }
 
+    /// The pose (3·`joints` values, mapped as [`Motion::poses_for_joints`]) and translation of
+    /// one frame.
+    pub fn frame_pose(&self, frame: usize, joints: usize) -> Result<(Vec<f32>, [f32; 3]), BodyError> {
+        if frame >= self.num_frames() {
+            return Err(BodyError::field(
+                &self.source,
+                "poses",
+                format!("frame {frame} asked, the motion has {} frames", self.num_frames()),
+            ));
+        }
+        let poses = self.poses_for_joints(joints)?;
+        let pose = poses[frame * 3 * joints..(frame + 1) * 3 * joints].to_vec();
+        Ok((pose, [0, 1, 2].map(|k| self.trans[3 * frame + k])))
+    }
+
     /// [`Motion::poses_for`] for a body with `target` joints.
     pub fn poses_for_joints(&self, target: usize) -> Result<Vec<f32>, BodyError> {
         if self.joints == target {

@@ -49,19 +49,7 @@ impl Args {
 /// Pose (3J values) and translation of the requested pose.
 fn chosen_pose(args: &Args, joints: usize) -> Result<(Vec<f32>, [f32; 3])> {
     if let Some(path) = &args.motion {
-        let motion = Motion::read(path)?;
-        if args.frame >= motion.num_frames() {
-            bail!(
-                "{}: frame {} asked, the motion has {} frames",
-                path.display(),
-                args.frame,
-                motion.num_frames()
-            );
-        }
-        let poses = motion.poses_for_joints(joints)?;
-        let pose = poses[args.frame * 3 * joints..(args.frame + 1) * 3 * joints].to_vec();
-        let transl = [0, 1, 2].map(|k| motion.trans[3 * args.frame + k]);
-        return Ok((pose, transl));
+        return Ok(Motion::read(path)?.frame_pose(args.frame, joints)?);
     }
     if args.canonical() {
         return Ok((vec![0.0; 3 * joints], [0.0; 3]));

@@ -81,19 +81,7 @@ fn frame_inputs(args: &Args, avatar: &Avatar) -> Result<(Vec<f32>, [f32; 3], Cam
         return Ok((split.poses.pose72(i), split.poses.transl[i], camera));
     }
     let Some(path) = &args.motion else { bail!("give --data or --motion") };
-    let motion = Motion::read(path)?;
-    if args.frame >= motion.num_frames() {
-        bail!(
-            "{}: frame {} asked, the motion has {} frames",
-            path.display(),
-            args.frame,
-            motion.num_frames()
-        );
-    }
-    let joints = avatar.canonical.num_joints();
-    let poses = motion.poses_for_joints(joints)?;
-    let pose = poses[args.frame * 3 * joints..(args.frame + 1) * 3 * joints].to_vec();
-    let transl = [0, 1, 2].map(|k| motion.trans[3 * args.frame + k]);
+    let (pose, transl) = Motion::read(path)?.frame_pose(args.frame, avatar.canonical.num_joints())?;
     let camera = match explicit {
         Some(c) => c,
         None => front_camera(box_centre(&avatar.pose_mesh(&pose, transl)?)),
