@@ -1,5 +1,12 @@
 //! Adam (Kingma & Ba 2015) over named parameters, each with its own learning rate, with state
 //! that a checkpoint can store and restore exactly, so a resumed run continues bit for bit.
+//! Each parameter's update is one fused backend op (`fused.rs`; Flex in `flex.rs`, CubeCL in
+//! `cube.rs` and `kernels.rs`).
+
+mod cube;
+mod flex;
+mod fused;
+mod kernels;
 
 use std::path::Path;
 
@@ -8,10 +15,7 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
 use crate::params::{Param, to_npy};
-
-const BETA1: f64 = 0.9;
-const BETA2: f64 = 0.999;
-const EPSILON: f64 = 1e-15;
+use fused::Coefficients;
 
 /// First and second moment estimates per parameter, on the parameters' inner device.
 #[derive(Clone, Debug)]
@@ -28,17 +32,21 @@ impl Adam {
     }
 
     /// One update of every parameter that received a gradient; the updated values are new
-    /// leaves that require gradients again.
+    /// leaves that require gradients again. The value and moments are moved into the op, so
+    /// where nothing else holds their buffers they are updated in place.
     pub fn update(&mut self, params: &mut [Param], grads: &Gradients) {
         self.step += 1;
-        let t = self.step as i32;
-        let (c1, c2) = (1.0 - BETA1.powi(t), 1.0 - BETA2.powi(t));
         for (k, p) in params.iter_mut().enumerate() {
             let Some(g) = p.value.grad(grads) else { continue };
-            self.m[k] = self.m[k].clone() * BETA1 + g.clone() * (1.0 - BETA1);
-            self.v[k] = self.v[k].clone() * BETA2 + g.square() * (1.0 - BETA2);
-            let step = (self.m[k].clone() / c1) / ((self.v[k].clone() / c2).sqrt() + EPSILON) * p.lr;
-            p.value = (p.value.clone().inner() - step).autodiff().require_grad();
+            let coefficients = Coefficients::new(self.step as i32, p.lr);
+            let (value, m, v) = fused::step(
+                take(&mut p.value).inner(),
+                g,
+                take(&mut self.m[k]),
+                take(&mut self.v[k]),
+                coefficients,
+            );
+            (p.value, self.m[k], self.v[k]) = (value.autodiff().require_grad(), m, v);
         }
     }
 
@@ -59,9 +67,16 @@ impl Adam {
             for (prefix, slot) in [("adam_m/", &mut adam.m[k]), ("adam_v/", &mut adam.v[k])] {
                 let mut moment = Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
                 moment.load(npz, prefix, path)?;
-                *slot = moment.value.inner();
+                // Checkpoints store f32; the op wants the parameter's dtype.
+                *slot = moment.value.inner().cast(p.value.dtype());
             }
         }
         Ok(adam)
     }
+}
+
+/// Moves `t` out, leaving an empty tensor of its kind, so the caller holds the only handle.
+fn take(t: &mut Tensor<2>) -> Tensor<2> {
+    let empty = Tensor::empty([0, 0], (&t.device(), t.dtype()));
+    std::mem::replace(t, empty)
 }
