@@ -8,6 +8,9 @@
 
 use std::path::Path;
 
+use mannequin_io::ply_header::{Element, Property, Scalar};
+use mannequin_io::{PlyHeader, PlyValueError, PlyValues};
+
 use crate::{MeshFileError, TriMesh};
 
 /// A mesh read from PLY, with the per-vertex normals the file carried, if any.
@@ -17,85 +20,14 @@ pub struct PlyMesh {
     pub normals: Option<Vec<[f32; 3]>>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    fn parse(name: &str) -> Option<Self> {
-        Some(match name {
-            "char" | "int8" => Self::I8,
-            "uchar" | "uint8" => Self::U8,
-            "short" | "int16" => Self::I16,
-            "ushort" | "uint16" => Self::U16,
-            "int" | "int32" => Self::I32,
-            "uint" | "uint32" => Self::U32,
-            "float" | "float32" => Self::F32,
-            "double" | "float64" => Self::F64,
-            _ => return None,
-        })
+/// The value that an integer colour channel of type `ty` takes at full intensity.
+fn colour_max(ty: Scalar) -> f64 {
+    match ty {
+        Scalar::U8 | Scalar::I8 => 255.0,
+        Scalar::U16 | Scalar::I16 => 65535.0,
+        Scalar::I32 | Scalar::U32 => u32::MAX as f64,
+        Scalar::F32 | Scalar::F64 => 1.0,
     }
-
-    fn size(self) -> usize {
-        match self {
-            Self::I8 | Self::U8 => 1,
-            Self::I16 | Self::U16 => 2,
-            Self::I32 | Self::U32 | Self::F32 => 4,
-            Self::F64 => 8,
-        }
-    }
-
-    /// The value that an integer colour channel of this type takes at full intensity.
-    fn colour_max(self) -> f64 {
-        match self {
-            Self::U8 | Self::I8 => 255.0,
-            Self::U16 | Self::I16 => 65535.0,
-            Self::I32 | Self::U32 => u32::MAX as f64,
-            Self::F32 | Self::F64 => 1.0,
-        }
-    }
-}
-
-#[derive(Debug, Clone)]
-enum Property {
-    Scalar { name: String, ty: Scalar },
-    List { name: String, count: Scalar, item: Scalar },
-}
-
-impl Property {
-    fn name(&self) -> &str {
-        match self {
-            Self::Scalar { name, .. } | Self::List { name, .. } => name,
-        }
-    }
-}
-
-#[derive(Debug, Clone)]
-struct Element {
-    name: String,
-    count: usize,
-    properties: Vec<Property>,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Format {
-    Ascii,
-    Binary { big_endian: bool },
-}
-
-struct Header {
-    format: Format,
-    elements: Vec<Element>,
-    /// Byte offset where the body starts.
-    body: usize,
 }
 
 /// Where in the file something is wrong, and what was expected there.
@@ -108,116 +40,11 @@ fn bad(at: impl Into<String>, expected: impl Into<String>) -> Problem {
     Problem { at: at.into(), expected: expected.into() }
 }
 
-fn parse_header(bytes: &[u8]) -> Result<Header, Problem> {
-    if !bytes.starts_with(b"ply") {
-        return Err(bad("start", "the 'ply' magic (this is not a PLY file)"));
-    }
-    let end_tag = b"end_header";
-    let pos = bytes
-        .windows(end_tag.len())
-        .position(|w| w == end_tag)
-        .ok_or_else(|| bad("header", "an 'end_header' line"))?;
-    let mut body = pos + end_tag.len();
-    // The header ends with "end_header" followed by one line break (\n or \r\n).
-    if bytes.get(body) == Some(&b'\r') {
-        body += 1;
-    }
-    if bytes.get(body) == Some(&b'\n') {
-        body += 1;
-    }
-    let text = std::str::from_utf8(&bytes[..pos]).map_err(|_| bad("header", "text"))?;
-    let mut format = None;
-    let mut elements: Vec<Element> = Vec::new();
-    for line in text.lines().skip(1) {
-        let words: Vec<&str> = line.split_whitespace().collect();
-        match words.as_slice() {
-            [] | ["comment", ..] | ["obj_info", ..] => {}
-            ["format", f, _version] => {
-                format = Some(match *f {
-                    "ascii" => Format::Ascii,
-                    "binary_little_endian" => Format::Binary { big_endian: false },
-                    "binary_big_endian" => Format::Binary { big_endian: true },
-                    _ => return Err(bad(format!("header line '{line}'"), "ascii or binary_*_endian")),
-                })
-            }
-            ["element", name, count] => elements.push(Element {
-                name: name.to_string(),
-                count: count
-                    .parse()
-                    .map_err(|_| bad(format!("header line '{line}'"), "a whole element count"))?,
-                properties: Vec::new(),
-            }),
-            ["property", "list", count, item, name] => {
-                let ty = |t: &str| {
-                    Scalar::parse(t).ok_or_else(|| bad(format!("header line '{line}'"), "a PLY type"))
-                };
-                let element = elements
-                    .last_mut()
-                    .ok_or_else(|| bad(format!("header line '{line}'"), "an element first"))?;
-                element.properties.push(Property::List {
-                    name: name.to_string(),
-                    count: ty(count)?,
-                    item: ty(item)?,
-                });
-            }
-            ["property", ty, name] => {
-                let ty =
-                    Scalar::parse(ty).ok_or_else(|| bad(format!("header line '{line}'"), "a PLY type"))?;
-                let element = elements
-                    .last_mut()
-                    .ok_or_else(|| bad(format!("header line '{line}'"), "an element first"))?;
-                element.properties.push(Property::Scalar { name: name.to_string(), ty });
-            }
-            _ => return Err(bad(format!("header line '{line}'"), "format, element, property or comment")),
-        }
-    }
-    Ok(Header { format: format.ok_or_else(|| bad("header", "a 'format' line"))?, elements, body })
-}
-
-/// Sequential reader of scalar values from the body, in either encoding.
-struct Body<'a> {
-    bytes: &'a [u8],
-    at: usize,
-    format: Format,
-}
-
-impl Body<'_> {
-    fn next_binary(&mut self, ty: Scalar, big_endian: bool) -> Result<f64, &'static str> {
-        let n = ty.size();
-        let raw = self.bytes.get(self.at..self.at + n).ok_or("more data (the file ends early)")?;
-        self.at += n;
-        let mut b = [0u8; 8];
-        b[..n].copy_from_slice(raw);
-        if big_endian {
-            b[..n].reverse();
-        }
-        Ok(match ty {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
-            Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
-            Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::F64 => f64::from_le_bytes(b),
-        })
-    }
-
-    fn next_ascii(&mut self) -> Result<f64, &'static str> {
-        let rest = &self.bytes[self.at..];
-        let start =
-            rest.iter().position(|c| !c.is_ascii_whitespace()).ok_or("more data (the file ends early)")?;
-        let len = rest[start..].iter().position(|c| c.is_ascii_whitespace()).unwrap_or(rest.len() - start);
-        self.at += start + len;
-        let word = std::str::from_utf8(&rest[start..start + len]).map_err(|_| "a number")?;
-        word.parse::<f64>().map_err(|_| "a number")
-    }
-
-    fn next(&mut self, ty: Scalar) -> Result<f64, &'static str> {
-        match self.format {
-            Format::Ascii => self.next_ascii(),
-            Format::Binary { big_endian } => self.next_binary(ty, big_endian),
-        }
+/// What a body value should have been, in this reader's "expected" phrasing.
+fn expected_value(e: PlyValueError) -> &'static str {
+    match e {
+        PlyValueError::End => "more data (the file ends early)",
+        PlyValueError::NotANumber => "a number",
     }
 }
 
@@ -252,8 +79,8 @@ fn vertex_slots(element: &Element) -> Result<VertexSlots, Problem> {
     Ok(s)
 }
 
-fn parse_body(header: &Header, bytes: &[u8]) -> Result<PlyMesh, Problem> {
-    let mut body = Body { bytes, at: header.body, format: header.format };
+fn parse_body(header: &PlyHeader, bytes: &[u8]) -> Result<PlyMesh, Problem> {
+    let mut body = PlyValues::new(bytes, header);
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     let mut colors = Vec::new();
@@ -285,15 +112,17 @@ fn parse_body(header: &Header, bytes: &[u8]) -> Result<PlyMesh, Problem> {
             for (pi, p) in element.properties.iter().enumerate() {
                 let at = || format!("element {} {row}, property {}", element.name, p.name());
                 match p {
-                    Property::Scalar { ty, .. } => record.push(body.next(*ty).map_err(|e| bad(at(), e))?),
+                    Property::Scalar { ty, .. } => {
+                        record.push(body.next(*ty).map_err(|e| bad(at(), expected_value(e)))?)
+                    }
                     Property::List { count, item, .. } => {
-                        let n = body.next(*count).map_err(|e| bad(at(), e))?;
+                        let n = body.next(*count).map_err(|e| bad(at(), expected_value(e)))?;
                         if n < 0.0 || n.fract() != 0.0 {
                             return Err(bad(at(), "a whole list length"));
                         }
                         let mut items = Vec::with_capacity((n as usize).min(64));
                         for _ in 0..n as usize {
-                            items.push(body.next(*item).map_err(|e| bad(at(), e))?);
+                            items.push(body.next(*item).map_err(|e| bad(at(), expected_value(e)))?);
                         }
                         if Some(pi) == face_list {
                             push_fan(&items, &at(), &mut faces)?;
@@ -311,7 +140,7 @@ fn parse_body(header: &Header, bytes: &[u8]) -> Result<PlyMesh, Problem> {
                 if has_colors {
                     colors.push(s.color.map(|c| {
                         let (i, ty) = c.unwrap_or((0, Scalar::F32));
-                        (record[i] / ty.colour_max()) as f32
+                        (record[i] / colour_max(ty)) as f32
                     }));
                 }
             }
@@ -340,9 +169,8 @@ fn push_fan(items: &[f64], at: &str, faces: &mut Vec<[u32; 3]>) -> Result<(), Pr
 
 /// Parses PLY bytes; `path` is used only in error messages.
 pub fn parse(path: &Path, bytes: &[u8]) -> Result<PlyMesh, MeshFileError> {
-    let err = |p: Problem| MeshFileError::format(path, p.at, p.expected);
-    let header = parse_header(bytes).map_err(err)?;
-    let ply = parse_body(&header, bytes).map_err(err)?;
+    let header = PlyHeader::parse(bytes).map_err(|e| MeshFileError::format(path, "header", e.to_string()))?;
+    let ply = parse_body(&header, bytes).map_err(|p| MeshFileError::format(path, p.at, p.expected))?;
     ply.mesh.validate().map_err(|e| MeshFileError::invalid(path, e))?;
     Ok(ply)
 }

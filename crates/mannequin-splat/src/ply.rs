@@ -6,6 +6,9 @@
 
 use std::path::{Path, PathBuf};
 
+use mannequin_io::ply_header::{Element, Format, Property};
+use mannequin_io::{PlyHeader, PlyValues};
+
 use crate::gaussians::{Colors, Gaussians, Rotations};
 use crate::{SplatError, sh};
 
@@ -20,183 +23,6 @@ pub struct SplatScene {
     pub opacities: Vec<f32>,
     pub sh_degree: usize,
     pub sh: Vec<f32>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Format {
-    Ascii,
-    BinaryLe,
-    BinaryBe,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    fn parse(s: &str) -> Option<Self> {
-        Some(match s {
-            "char" | "int8" => Scalar::I8,
-            "uchar" | "uint8" => Scalar::U8,
-            "short" | "int16" => Scalar::I16,
-            "ushort" | "uint16" => Scalar::U16,
-            "int" | "int32" => Scalar::I32,
-            "uint" | "uint32" => Scalar::U32,
-            "float" | "float32" => Scalar::F32,
-            "double" | "float64" => Scalar::F64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::F64 => 8,
-        }
-    }
-
-    /// Decodes one value from the front of `b` (which holds at least `size()` bytes).
-    fn decode(self, b: &[u8], big_endian: bool) -> f64 {
-        macro_rules! num {
-            ($t:ty, $n:expr) => {{
-                let a: [u8; $n] = b[..$n].try_into().expect("length checked by the caller");
-                (if big_endian { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) }) as f64
-            }};
-        }
-        match self {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => num!(i16, 2),
-            Scalar::U16 => num!(u16, 2),
-            Scalar::I32 => num!(i32, 4),
-            Scalar::U32 => num!(u32, 4),
-            Scalar::F32 => num!(f32, 4),
-            Scalar::F64 => num!(f64, 8),
-        }
-    }
-}
-
-#[derive(Clone, Debug)]
-enum Property {
-    Scalar { name: String, ty: Scalar },
-    List { name: String, count: Scalar, item: Scalar },
-}
-
-#[derive(Clone, Debug)]
-struct Element {
-    name: String,
-    count: usize,
-    props: Vec<Property>,
-}
-
-/// The header, and where the body starts.
-struct Header {
-    format: Format,
-    elements: Vec<Element>,
-    body: usize,
-}
-
-fn parse_header(bytes: &[u8], err: &dyn Fn(String) -> SplatError) -> Result<Header, SplatError> {
-    const END: &[u8] = b"end_header";
-    let end = bytes
-        .windows(END.len())
-        .position(|w| w == END)
-        .ok_or_else(|| err("no 'end_header' line: not a PLY file, or a truncated one".into()))?;
-    let mut body = end + END.len();
-    // The header ends with "end_header\n" (or "\r\n").
-    if bytes.get(body) == Some(&b'\r') {
-        body += 1;
-    }
-    if bytes.get(body) != Some(&b'\n') {
-        return Err(err("'end_header' is not followed by a newline".into()));
-    }
-    body += 1;
-    let text = std::str::from_utf8(&bytes[..end]).map_err(|_| err("header is not valid text".into()))?;
-    let mut lines = text.lines().map(str::trim);
-    if lines.next() != Some("ply") {
-        return Err(err("does not start with 'ply'".into()));
-    }
-    let mut format = None;
-    let mut elements: Vec<Element> = Vec::new();
-    for line in lines {
-        let words: Vec<&str> = line.split_whitespace().collect();
-        match words.as_slice() {
-            [] | ["comment", ..] | ["obj_info", ..] => {}
-            ["format", f, _version] => {
-                format = Some(match *f {
-                    "ascii" => Format::Ascii,
-                    "binary_little_endian" => Format::BinaryLe,
-                    "binary_big_endian" => Format::BinaryBe,
-                    other => return Err(err(format!("unknown format '{other}'"))),
-                })
-            }
-            ["element", name, count] => {
-                let count =
-                    count.parse().map_err(|_| err(format!("element '{name}' has a bad count '{count}'")))?;
-                elements.push(Element { name: name.to_string(), count, props: vec![] });
-            }
-            ["property", "list", count, item, name] => {
-                let el = elements
-                    .last_mut()
-                    .ok_or_else(|| err(format!("property '{name}' before any element")))?;
-                let bad = |t: &str| err(format!("property '{name}': unknown type '{t}'"));
-                let (count, item) = (
-                    Scalar::parse(count).ok_or_else(|| bad(count))?,
-                    Scalar::parse(item).ok_or_else(|| bad(item))?,
-                );
-                el.props.push(Property::List { name: name.to_string(), count, item });
-            }
-            ["property", ty, name] => {
-                let el = elements
-                    .last_mut()
-                    .ok_or_else(|| err(format!("property '{name}' before any element")))?;
-                let ty = Scalar::parse(ty)
-                    .ok_or_else(|| err(format!("property '{name}': unknown type '{ty}'")))?;
-                el.props.push(Property::Scalar { name: name.to_string(), ty });
-            }
-            _ => return Err(err(format!("cannot parse header line '{line}'"))),
-        }
-    }
-    let format = format.ok_or_else(|| err("no 'format' line in the header".into()))?;
-    Ok(Header { format, elements, body })
-}
-
-/// Reads elements one record at a time, in whichever encoding the file uses.
-struct Body<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-    format: Format,
-}
-
-impl Body<'_> {
-    /// The next scalar of type `ty`, or `None` at the end of the data.
-    fn value(&mut self, ty: Scalar) -> Option<f64> {
-        match self.format {
-            Format::Ascii => {
-                let rest = &self.bytes[self.pos..];
-                let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
-                let len =
-                    rest[start..].iter().position(|b| b.is_ascii_whitespace()).unwrap_or(rest.len() - start);
-                self.pos += start + len;
-                std::str::from_utf8(&rest[start..start + len]).ok()?.parse().ok()
-            }
-            Format::BinaryLe | Format::BinaryBe => {
-                let b = self.bytes.get(self.pos..self.pos + ty.size())?;
-                self.pos += ty.size();
-                Some(ty.decode(b, self.format == Format::BinaryBe))
-            }
-        }
-    }
 }
 
 /// Where each INRIA field sits in a vertex record.
@@ -246,12 +72,11 @@ impl SplatScene {
     /// Parses `.ply` bytes; `path` only labels errors.
     pub fn from_ply_bytes(path: &Path, bytes: &[u8]) -> Result<Self, SplatError> {
         let err = |reason: String| SplatError::Ply { path: PathBuf::from(path), reason };
-        let header = parse_header(bytes, &err)?;
-        let mut body = Body { bytes, pos: header.body, format: header.format };
-        let remaining = bytes.len() - header.body;
+        let header = PlyHeader::parse(bytes).map_err(|e| err(e.to_string()))?;
+        let mut body = PlyValues::new(bytes, &header);
         for el in &header.elements {
             if el.name == "vertex" {
-                return Self::read_vertices(el, &mut body, remaining, &err);
+                return Self::read_vertices(el, &mut body, &err);
             }
             skip_element(el, &mut body, &err)?;
         }
@@ -260,13 +85,12 @@ impl SplatScene {
 
     fn read_vertices(
         el: &Element,
-        body: &mut Body,
-        remaining: usize,
+        body: &mut PlyValues,
         err: &dyn Fn(String) -> SplatError,
     ) -> Result<Self, SplatError> {
-        let mut types = Vec::with_capacity(el.props.len());
+        let mut types = Vec::with_capacity(el.properties.len());
         let mut index = std::collections::HashMap::new();
-        for (k, p) in el.props.iter().enumerate() {
+        for (k, p) in el.properties.iter().enumerate() {
             match p {
                 Property::Scalar { name, ty } => {
                     types.push(*ty);
@@ -282,10 +106,11 @@ impl SplatScene {
         let layout = Layout { index };
         // Each record takes at least one byte per property (binary) or two characters (ASCII),
         // so a count beyond that is a lie and must not drive allocation.
-        let min_record = match body.format {
+        let min_record = match body.format() {
             Format::Ascii => 2 * types.len(),
-            _ => types.iter().map(|t| t.size()).sum(),
+            Format::Binary { .. } => types.iter().map(|t| t.size()).sum(),
         };
+        let remaining = body.remaining();
         if el.count.saturating_mul(min_record.max(1)) > remaining {
             return Err(err(format!(
                 "header declares {} vertices but the file holds at most {}",
@@ -318,13 +143,11 @@ impl SplatScene {
         let mut rec = vec![0.0f64; types.len()];
         let mut coeffs = vec![0.0f32; 3 * k];
         for v in 0..n {
-            for (slot, (&ty, p)) in rec.iter_mut().zip(types.iter().zip(&el.props)) {
-                *slot = body.value(ty).ok_or_else(|| {
-                    let name = match p {
-                        Property::Scalar { name, .. } | Property::List { name, .. } => name,
-                    };
+            for (slot, (&ty, p)) in rec.iter_mut().zip(types.iter().zip(&el.properties)) {
+                *slot = body.next(ty).map_err(|_| {
                     err(format!(
-                        "vertex {v} of {n}: property '{name}' is missing or not a number (truncated file?)"
+                        "vertex {v} of {n}: property '{}' is missing or not a number (truncated file?)",
+                        p.name()
                     ))
                 })?;
             }
@@ -400,21 +223,25 @@ impl SplatScene {
 }
 
 /// Skips the records of an element that is not `vertex`.
-fn skip_element(el: &Element, body: &mut Body, err: &dyn Fn(String) -> SplatError) -> Result<(), SplatError> {
+fn skip_element(
+    el: &Element,
+    body: &mut PlyValues,
+    err: &dyn Fn(String) -> SplatError,
+) -> Result<(), SplatError> {
     let short = || err(format!("element '{}' is truncated", el.name));
     for _ in 0..el.count {
-        for p in &el.props {
+        for p in &el.properties {
             match p {
                 Property::Scalar { ty, .. } => {
-                    body.value(*ty).ok_or_else(short)?;
+                    body.next(*ty).map_err(|_| short())?;
                 }
                 Property::List { count, item, .. } => {
-                    let len = body.value(*count).ok_or_else(short)?;
-                    if !(len >= 0.0 && len <= (body.bytes.len() - body.pos) as f64) {
+                    let len = body.next(*count).map_err(|_| short())?;
+                    if !(len >= 0.0 && len <= body.remaining() as f64) {
                         return Err(short());
                     }
                     for _ in 0..len as usize {
-                        body.value(*item).ok_or_else(short)?;
+                        body.next(*item).map_err(|_| short())?;
                     }
                 }
             }
@@ -485,7 +312,8 @@ mod tests {
         let p = Path::new("bad.ply");
         let msg = |b: &[u8]| SplatScene::from_ply_bytes(p, b).unwrap_err().to_string();
         assert!(msg(b"hello").contains("bad.ply"));
-        assert!(msg(b"hello").contains("end_header"));
+        assert!(msg(b"hello").contains("'ply'"));
+        assert!(msg(b"ply\nformat ascii 1.0\nelement vertex 1\n").contains("end_header"));
         let header = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
                       property float z\nend_header\n";
         assert!(msg(header.as_bytes()).contains("at most 0"));
