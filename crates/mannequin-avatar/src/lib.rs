@@ -27,4 +27,4 @@ pub use config::{AvatarConfig, Method};
 pub use error::AvatarError;
 pub use predict::{Prediction, predict, predict_split};
 pub use trainer::{StepStats, Timings, TrainOptions, Trainer};
-pub use views::{View, load_views, splat_camera};
+pub use views::{View, frame_camera, load_views};

@@ -10,7 +10,7 @@ use mannequin_mesh::TriMesh;
 
 use crate::avatar::Avatar;
 use crate::error::AvatarError;
-use crate::views::splat_camera;
+use crate::views::frame_camera;
 
 /// A pixel belongs to the avatar where its alpha reaches this.
 const FOREGROUND_ALPHA: f32 = 0.5;
@@ -81,7 +81,7 @@ pub fn predict_split(
     let split = dataset.split(split)?;
     let writer = DatasetWriter::new(out);
     for (i, &frame) in split.frames.iter().enumerate() {
-        let camera = splat_camera(dataset.camera(frame));
+        let camera = frame_camera(dataset, frame);
         let p = predict(avatar, &camera, &split.poses.pose72(i), split.poses.transl[i])?;
         writer.write_frame(&Frame {
             index: frame,

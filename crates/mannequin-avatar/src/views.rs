@@ -14,16 +14,9 @@ const MIN_CROP: usize = 11;
 const NEAR: f64 = 0.01;
 const FAR: f64 = 100.0;
 
-/// The renderer's camera for a dataset camera (same OpenCV conventions).
-pub fn splat_camera(c: &mannequin_data::Camera) -> mannequin_splat::Camera {
-    mannequin_splat::Camera {
-        width: c.width,
-        height: c.height,
-        intrinsic: c.intrinsic,
-        extrinsic: c.extrinsic,
-        near: NEAR,
-        far: FAR,
-    }
+/// The camera of a dataset frame, clipping at the avatar's depth range (datasets store none).
+pub fn frame_camera(dataset: &Dataset, frame: usize) -> mannequin_splat::Camera {
+    mannequin_splat::Camera { near: NEAR, far: FAR, ..dataset.camera(frame).clone() }
 }
 
 /// A pixel rectangle.
@@ -84,7 +77,7 @@ pub fn load_views(
     let mut views = Vec::with_capacity(split.frames.len());
     for (i, &frame) in split.frames.iter().enumerate() {
         let f = dataset.frame(frame)?;
-        let camera = splat_camera(dataset.camera(frame));
+        let camera = frame_camera(dataset, frame);
         if camera.width < MIN_CROP || camera.height < MIN_CROP {
             return Err(AvatarError::Invalid(format!(
                 "frame {frame}: images of {}×{} are too small to train on (at least {MIN_CROP}×{MIN_CROP})",

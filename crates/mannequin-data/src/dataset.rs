@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use mannequin_io::Npz;
 use mannequin_mesh::ply::{self, PlyMesh};
 
-use crate::camera::Camera;
+use crate::Camera;
 use crate::error::DataError;
 use crate::image::{Image, Mask};
 use crate::layout;
@@ -16,6 +16,7 @@ use crate::poses::Poses;
 use crate::splits::{SplitRange, Splits, read_splits_json, standard_splits};
 
 /// One camera for the whole capture (PeopleSnapshot), or one per frame (novel-view sets).
+#[allow(clippy::large_enum_variant)] // one per dataset: boxing the single camera would buy nothing
 #[derive(Debug, Clone, PartialEq)]
 pub enum Cameras {
     Static(Camera),
@@ -57,11 +58,13 @@ impl Cameras {
         let e_shape = npz.require("extrinsic")?.shape.clone();
         let (_, k) = npz.f64_with_shape("intrinsic", &vec![None; k_shape.len()])?;
         let (_, e) = npz.f64_with_shape("extrinsic", &vec![None; e_shape.len()])?;
-        let camera = |k: &[f64], e: &[f64]| Camera {
-            intrinsic: std::array::from_fn(|r| std::array::from_fn(|c| k[3 * r + c])),
-            extrinsic: std::array::from_fn(|r| std::array::from_fn(|c| e[4 * r + c])),
-            width,
-            height,
+        let camera = |k: &[f64], e: &[f64]| {
+            Camera::new(
+                width,
+                height,
+                std::array::from_fn(|r| std::array::from_fn(|c| k[3 * r + c])),
+                std::array::from_fn(|r| std::array::from_fn(|c| e[4 * r + c])),
+            )
         };
         match (k_shape.as_slice(), e_shape.as_slice()) {
             ([3, 3], [4, 4]) => Ok(Self::Static(camera(&k, &e))),

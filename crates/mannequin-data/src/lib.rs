@@ -1,7 +1,6 @@
 //! Datasets, ground truth and metrics: the PeopleSnapshot-layout reader and writer, a CPU mesh
 //! rasterizer for ground-truth images, synthetic subjects, and the metrics the papers report.
 
-pub mod camera;
 pub mod dataset;
 pub mod error;
 pub mod evaluation;
@@ -16,10 +15,11 @@ pub mod splits;
 pub mod synth;
 pub mod writer;
 
-pub use camera::Camera;
 pub use dataset::{Cameras, Dataset, Frame, Split};
 pub use error::DataError;
 pub use image::{Image, Mask};
+/// The one camera type of the project, shared with the renderer.
+pub use mannequin_splat::Camera;
 pub use maps::{DepthMap, NormalMap};
 pub use poses::Poses;
 pub use splits::{SplitRange, Splits, standard_splits};

@@ -10,7 +10,7 @@ use glam::{DMat3, DVec3, Vec2, Vec3};
 use mannequin_mesh::UvLayout;
 use rayon::prelude::*;
 
-use crate::camera::Camera;
+use crate::Camera;
 use crate::image::{Image, Mask};
 use crate::maps::{DepthMap, NormalMap};
 

@@ -7,12 +7,12 @@ use mannequin_mesh::UvLayout;
 
 fn camera(w: usize, h: usize) -> Camera {
     // Slightly off-centre principal point and unequal focal lengths, to catch axis mix-ups.
-    Camera {
-        intrinsic: [[90.0, 0.0, 33.3], [0.0, 80.0, 27.1], [0.0, 0.0, 1.0]],
-        extrinsic: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]],
-        width: w,
-        height: h,
-    }
+    Camera::new(
+        w,
+        h,
+        [[90.0, 0.0, 33.3], [0.0, 80.0, 27.1], [0.0, 0.0, 1.0]],
+        [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]],
+    )
 }
 
 /// Where the ray through pixel centre (x, y) meets the plane through `o` spanned by `a`, `b`:
@@ -153,7 +153,7 @@ fn sphere_normal_map_matches_analytic_normals() {
         shading: Shading::Flat([1.0; 3]),
     };
     let out = rasterize(&mesh, &cam, [0.0; 3]);
-    let (rot, eye) = (cam.rotation(), cam.centre());
+    let (rot, eye) = (cam.rotation(), DVec3::from(cam.centre()));
     let (mut checked, mut worst) = (0, 0.0f64);
     for y in 0..cam.height {
         for x in 0..cam.width {

@@ -1,11 +1,14 @@
 //! The pinhole camera, in the OpenCV convention: x right, y down, z forward, `K` in pixels,
-//! a rigid world→camera transform, and pixel centres at +0.5.
+//! a rigid world→camera transform, and pixel centres at +0.5. The renderer, the datasets and the
+//! ground-truth rasterizer all use this one type.
+
+use glam::{DMat3, DVec3};
 
 use crate::SplatError;
 use crate::real::Real;
 
-/// A pinhole camera. Build it field by field or with [`Camera::look_at`], then
-/// [`Camera::validate`] (the renderer does this for you).
+/// A pinhole camera. Build it field by field, with [`Camera::new`] or with [`Camera::look_at`],
+/// then [`Camera::validate`] (the renderer does this for you).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     pub width: usize,
@@ -23,9 +26,15 @@ pub struct Camera {
 const MAX_SIDE: usize = 1 << 15;
 
 impl Camera {
+    /// A camera from its matrices, clipping at near 0.01 and far 1e10: nothing a human-scale
+    /// scene holds is culled, so callers that want a tighter depth range set it themselves.
+    pub fn new(width: usize, height: usize, intrinsic: [[f64; 3]; 3], extrinsic: [[f64; 4]; 4]) -> Self {
+        Camera { width, height, intrinsic, extrinsic, near: 0.01, far: 1e10 }
+    }
+
     /// A camera at `eye` looking at `target`, with world `up` pointing up in the image, a
     /// horizontal field of view `fov_x` (radians), square pixels and the principal point at the
-    /// image centre; near 0.01, far 1e10.
+    /// image centre; near and far as in [`Camera::new`].
     pub fn look_at(
         eye: [f64; 3],
         target: [f64; 3],
@@ -48,19 +57,62 @@ impl Camera {
         let y = cross(z, x);
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         let f = 0.5 * width as f64 / (0.5 * fov_x).tan();
-        Camera {
+        Camera::new(
             width,
             height,
-            intrinsic: [[f, 0.0, 0.5 * width as f64], [0.0, f, 0.5 * height as f64], [0.0, 0.0, 1.0]],
-            extrinsic: [
+            [[f, 0.0, 0.5 * width as f64], [0.0, f, 0.5 * height as f64], [0.0, 0.0, 1.0]],
+            [
                 [x[0], x[1], x[2], -dot(x, eye)],
                 [y[0], y[1], y[2], -dot(y, eye)],
                 [z[0], z[1], z[2], -dot(z, eye)],
                 [0.0, 0.0, 0.0, 1.0],
             ],
-            near: 0.01,
-            far: 1e10,
+        )
+    }
+
+    /// The same camera for images downscaled by `factor` (box filter on whole blocks): fx, fy, cx,
+    /// cy divide by `factor` because pixel centres map as `u' = u / factor`.
+    pub fn downscale(&self, factor: usize) -> Self {
+        let mut k = self.intrinsic;
+        let s = factor as f64;
+        for row in &mut k[..2] {
+            row.iter_mut().for_each(|v| *v /= s);
         }
+        Camera { intrinsic: k, width: self.width / factor, height: self.height / factor, ..self.clone() }
+    }
+
+    /// World→camera rotation `R`.
+    pub fn rotation(&self) -> DMat3 {
+        let e = &self.extrinsic;
+        DMat3::from_cols_array_2d(&[
+            [e[0][0], e[1][0], e[2][0]],
+            [e[0][1], e[1][1], e[2][1]],
+            [e[0][2], e[1][2], e[2][2]],
+        ])
+    }
+
+    /// World→camera translation `t`.
+    pub fn translation(&self) -> DVec3 {
+        DVec3::new(self.extrinsic[0][3], self.extrinsic[1][3], self.extrinsic[2][3])
+    }
+
+    pub fn world_to_camera(&self, p: DVec3) -> DVec3 {
+        self.rotation() * p + self.translation()
+    }
+
+    /// Pixel coordinates of a camera-space point (continuous; pixel centres at +0.5).
+    pub fn project(&self, pc: DVec3) -> [f64; 2] {
+        let k = &self.intrinsic;
+        let (x, y) = (pc.x / pc.z, pc.y / pc.z);
+        [k[0][0] * x + k[0][1] * y + k[0][2], k[1][1] * y + k[1][2]]
+    }
+
+    /// The camera-space direction (z = 1) through continuous pixel coordinates `(u, v)`.
+    pub fn unproject(&self, u: f64, v: f64) -> DVec3 {
+        let k = &self.intrinsic;
+        let y = (v - k[1][2]) / k[1][1];
+        let x = (u - k[0][2] - k[0][1] * y) / k[0][0];
+        DVec3::new(x, y, 1.0)
     }
 
     /// Checks that the camera can form an image, with a message naming the faulty part.
@@ -198,6 +250,36 @@ mod tests {
         assert!(to_cam([0.0, 1.5, 0.0])[1] < 0.0);
         let c = cam.centre();
         assert!((c[0]).abs() < 1e-12 && (c[1] - 1.0).abs() < 1e-12 && (c[2] - 2.5).abs() < 1e-12);
+    }
+
+    /// Projection agrees with the explicit extrinsic: the target lands on the principal point and
+    /// a point above it lands higher in the image (y points down).
+    #[test]
+    fn project_puts_the_target_at_the_principal_point() {
+        let cam = Camera::look_at([1.0, 1.5, 3.0], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0], 0.8, 540, 540);
+        let pc = cam.world_to_camera(DVec3::new(0.0, 1.0, 0.0));
+        assert!(pc.z > 0.0);
+        let [u, v] = cam.project(pc);
+        assert!((u - 270.0).abs() < 1e-9 && (v - 270.0).abs() < 1e-9);
+        let [_, v_up] = cam.project(cam.world_to_camera(DVec3::new(0.0, 1.2, 0.0)));
+        assert!(v_up < v);
+        let c = cam.rotation().transpose() * -cam.translation();
+        assert!(
+            (c - DVec3::new(1.0, 1.5, 3.0)).length() < 1e-12
+                && (c - DVec3::from(cam.centre())).length() < 1e-12
+        );
+    }
+
+    #[test]
+    fn downscale_maps_pixel_coordinates_by_the_factor() {
+        let cam = Camera::look_at([0.3, 0.2, -2.0], [0.0; 3], [0.0, 1.0, 0.0], 0.7, 1080, 1080);
+        let small = cam.downscale(2);
+        let p = cam.world_to_camera(DVec3::new(0.1, -0.2, 0.05));
+        let (a, b) = (cam.project(p), small.project(p));
+        assert!((a[0] / 2.0 - b[0]).abs() < 1e-9 && (a[1] / 2.0 - b[1]).abs() < 1e-9);
+        assert_eq!((small.width, small.height, small.near, small.far), (540, 540, cam.near, cam.far));
+        let d = cam.unproject(a[0], a[1]) * p.z;
+        assert!((d - p).length() < 1e-9);
     }
 
     #[test]

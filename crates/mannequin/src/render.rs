@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
-use mannequin_avatar::{Avatar, predict, splat_camera};
+use mannequin_avatar::{Avatar, frame_camera, predict};
 use mannequin_body::Motion;
 use mannequin_data::{Dataset, Image};
 use mannequin_splat::Camera;
@@ -77,7 +77,7 @@ fn frame_inputs(args: &Args, avatar: &Avatar) -> Result<(Vec<f32>, [f32; 3], Cam
                 split.frames
             )
         })?;
-        let camera = explicit.unwrap_or_else(|| splat_camera(dataset.camera(args.frame)));
+        let camera = explicit.unwrap_or_else(|| frame_camera(&dataset, args.frame));
         return Ok((split.poses.pose72(i), split.poses.transl[i], camera));
     }
     let Some(path) = &args.motion else { bail!("give --data or --motion") };

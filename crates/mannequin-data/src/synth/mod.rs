@@ -15,7 +15,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::camera::Camera;
+use crate::Camera;
 use crate::dataset::{Cameras, Frame};
 use crate::error::DataError;
 use crate::poses::{BODY_POSE_LEN, Poses};

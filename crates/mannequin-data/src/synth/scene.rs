@@ -12,7 +12,7 @@ use super::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoot
 use super::skirt::{Skirt, build_skirt};
 use super::subject::{Outfit, Subject};
 use super::texture::{BakeInput, SurfacePoint, bake};
-use crate::camera::Camera;
+use crate::Camera;
 use crate::error::DataError;
 use crate::image::{Image, Mask};
 use crate::maps::{DepthMap, NormalMap};
