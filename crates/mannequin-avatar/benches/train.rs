@@ -79,7 +79,7 @@ fn run(
         println!("    of which render backward    {:8.2}  (measured alone)", ms(render_backward));
         println!("  optimiser                     {:8.2}", ms(sum.optimiser / n));
     }
-    let model_dir = dir.join(name);
+    let model_dir = dir.join(name.replace("w/o ", "without-"));
     trainer.avatar.save(&model_dir).expect("save");
     let options = EvalOptions { background: [1.0; 3], lpips: None, samples: 100_000, seed: 0 };
     let scores = evaluate_avatar(&model_dir, data, &options, &|_, _| {}, &|| {}).expect("evaluate");

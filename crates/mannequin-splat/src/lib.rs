@@ -10,7 +10,8 @@
 //! - [`render`] and [`backward`]: the CPU renderer on slices, generic over `f32`/`f64` (rayon,
 //!   16-lane rows, no per-pixel allocation);
 //! - [`splat_render`]: the same as a differentiable Burn op on tensors, on Flex (the CPU code in
-//!   place) and on the CubeCL backends (device kernels; binning on the host);
+//!   place) and on the CubeCL backends (device kernels throughout: projection, binning by a
+//!   stable radix sort, compositing, and both backward passes);
 //! - [`SplatScene`]: 3DGS `.ply` files in the INRIA layout.
 //!
 //! ```
