@@ -98,6 +98,10 @@ impl Avatar {
             ));
         }
         let (v, f) = (canonical.num_vertices(), canonical.faces.len());
+        let index = MeshIndex::new(v, &canonical.faces, device);
+        let vertices = tensor_from(flat(&canonical.vertices), v, 3, device);
+        // Learned in-plane scales start where the analytic ones are on the canonical mesh.
+        let log_in_plane = |g: GaussianGeometry| g.scales.narrow(1, 0, 2).clamp_min(1e-5).log().detach();
         let mut rng = SplitMix64::new(config.seed);
         let mut params = Vec::new();
         let offsets =
@@ -118,8 +122,8 @@ impl Avatar {
                     slots.sh_rest = Some(params.len() - 1);
                 }
                 if !config.face_gaussians {
-                    let init = ihuman::log_edge_scales(&canonical);
-                    params.push(Param::new("vertex_log_scales", tensor_from(init, v, 2, device), 1e-3));
+                    let init = log_in_plane(vertex_gaussians(&vertices, &index));
+                    params.push(Param::new("vertex_log_scales", init, 1e-3));
                     slots.vertex_log_scales = Some(params.len() - 1);
                 }
             }
@@ -127,8 +131,8 @@ impl Avatar {
                 let centroids = ihuman::face_centroids(&canonical);
                 colour_field =
                     Some(Field::new("colour", &config, &centroids, 3, 5e-4, &mut rng, device, &mut params)?);
-                let init = ihuman::log_inradius_scales(&canonical);
-                params.push(Param::new("face_log_scales", tensor_from(init, f, 2, device), 5e-3));
+                let init = log_in_plane(face_gaussians(&vertices, &index));
+                params.push(Param::new("face_log_scales", init, 5e-3));
                 slots.face_log_scales = Some(params.len() - 1);
                 let identity: Vec<f32> = (0..f).flat_map(|_| [1.0, 0.0]).collect();
                 params.push(Param::new("face_rotation", tensor_from(identity, f, 2, device), 5e-3));
@@ -143,8 +147,8 @@ impl Avatar {
             tensor_from(canonical.posedirs.clone(), canonical.posedirs.len() / (3 * v), 3 * v, device)
         });
         Ok(Self {
-            index: MeshIndex::new(v, &canonical.faces, device),
-            vertices: tensor_from(flat(&canonical.vertices), v, 3, device),
+            index,
+            vertices,
             weights: tensor_from(canonical.weights.clone(), v, j, device),
             rest_joints: tensor_from(flat(&canonical.joints), j, 3, device),
             posedirs,

@@ -3,6 +3,7 @@
 //! Each Gaussian takes the mean target colour of the pixels it lands on in the views where it
 //! faces the camera and is the visible surface (its depth matches the rendered depth).
 
+use glam::DVec3;
 use mannequin_splat::sh;
 
 use crate::avatar::Avatar;
@@ -31,7 +32,6 @@ pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f
         let means = host(posed.gaussians.means);
         let normals = host(posed.gaussians.normals);
         let cam = &view.camera;
-        let (k, e) = (cam.intrinsic, cam.extrinsic);
         let eye = cam.centre();
         let (crop, n) = (view.crop, view.crop.width * view.crop.height);
         for i in 0..g {
@@ -41,17 +41,17 @@ pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f
             if facing <= 0.0 {
                 continue;
             }
-            let c = [0, 1, 2].map(|r| (0..3).map(|a| e[r][a] * p[a]).sum::<f64>() + e[r][3]);
-            if c[2] <= cam.near {
+            let c = cam.world_to_camera(DVec3::from(p));
+            if c.z <= cam.near {
                 continue;
             }
-            let (u, v) = (k[0][0] * c[0] / c[2] + k[0][2], k[1][1] * c[1] / c[2] + k[1][2]);
+            let [u, v] = cam.project(c);
             if u < 0.0 || v < 0.0 || u >= cam.width as f64 || v >= cam.height as f64 {
                 continue;
             }
             let (x, y) = (u as usize, v as usize);
             let px = y * cam.width + x;
-            if alpha[px] < 0.5 || (depth[px] as f64 / alpha[px] as f64 - c[2]).abs() > DEPTH_TOLERANCE {
+            if alpha[px] < 0.5 || (depth[px] as f64 / alpha[px] as f64 - c.z).abs() > DEPTH_TOLERANCE {
                 continue;
             }
             if x < crop.x || y < crop.y || x >= crop.x + crop.width || y >= crop.y + crop.height {

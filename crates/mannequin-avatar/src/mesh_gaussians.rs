@@ -107,7 +107,7 @@ fn row_norm(x: Tensor<2>) -> Tensor<2> {
 }
 
 /// Unit rows.
-fn normalise(x: Tensor<2>) -> Tensor<2> {
+pub(crate) fn normalise(x: Tensor<2>) -> Tensor<2> {
     x.clone() / row_norm(x)
 }
 
