@@ -240,9 +240,7 @@ impl Avatar {
 
     /// Posed vertices on the host, for cameras, exports and metrics.
     pub fn pose_mesh(&self, pose: &[f32], transl: [f32; 3]) -> Result<Vec<[f32; 3]>, AvatarError> {
-        let vertices = self.skin(self.personalised(self.offsets()?), pose, transl)?;
-        let flat: Vec<f32> = vertices.into_data().iter::<f32>().collect();
-        Ok(flat.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect())
+        Ok(crate::params::host_rows(self.skin(self.personalised(self.offsets()?), pose, transl)?))
     }
 
     /// Gaussians on posed vertices, by the configured binding.

@@ -8,16 +8,13 @@ use mannequin_splat::sh;
 
 use crate::avatar::Avatar;
 use crate::error::AvatarError;
+use crate::params::host;
 use crate::views::View;
 
 /// Views sampled for the estimate.
 const SAMPLED_VIEWS: usize = 24;
 /// A Gaussian counts as visible where its depth is within this of the rendered surface (m).
 const DEPTH_TOLERANCE: f64 = 0.02;
-
-fn host(t: burn::tensor::Tensor<2>) -> Vec<f32> {
-    t.into_data().iter::<f32>().collect()
-}
 
 /// Mean observed RGB per Gaussian, or `None` where no sampled view saw it.
 pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f32; 3]>>, AvatarError> {

@@ -2,7 +2,6 @@
 //! any splat viewer shows it), per-vertex colour baked from the Gaussians' view-independent (DC)
 //! colour, and the personalised mesh skinned for glTF.
 
-use burn::tensor::Tensor;
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::gltf::{Skeleton, SkinnedMesh};
 use mannequin_splat::{SplatScene, sh};
@@ -11,6 +10,7 @@ use crate::avatar::{Avatar, Posed};
 use crate::config::Method;
 use crate::error::AvatarError;
 use crate::mesh_gaussians::GaussianGeometry;
+use crate::params::{host, host_rows};
 
 /// Y₀₀ = 1 / (2√π): 3DGS shows a DC coefficient `dc` as the colour 0.5 + C0·dc.
 pub const SH_C0: f64 = 0.282_094_791_773_878_1;
@@ -21,11 +21,6 @@ const OPACITY: f32 = 1.0;
 
 /// Colour of a vertex that no Gaussian covers (one in no face): DC zero.
 const UNCOVERED: [f32; 3] = [0.5; 3];
-
-fn rows3(t: Tensor<2>) -> Vec<[f32; 3]> {
-    let flat: Vec<f32> = t.into_data().iter::<f32>().collect();
-    flat.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect()
-}
 
 /// Unit quaternion (w, x, y, z) with w ≥ 0 of a Gaussian frame `m`, row-major, whose columns are
 /// (t1, t2, n). A left-handed frame has t2 negated first: a quaternion holds only proper
@@ -102,7 +97,7 @@ pub fn sh_coefficients(
 /// every opacity is 1, colours are [`sh_coefficients`].
 pub fn gaussian_scene(avatar: &Avatar, gaussians: &GaussianGeometry) -> Result<SplatScene, AvatarError> {
     let (sh_degree, sh) = sh_coefficients(avatar, gaussians)?;
-    let frames: Vec<f32> = gaussians.frames.clone().into_data().iter::<f32>().collect();
+    let frames = host(gaussians.frames.clone());
     let quaternions = frames
         .chunks_exact(9)
         .flat_map(|f| {
@@ -110,11 +105,10 @@ pub fn gaussian_scene(avatar: &Avatar, gaussians: &GaussianGeometry) -> Result<S
             frame_quaternion(m).map(|c| c as f32)
         })
         .collect();
-    let host = |t: &Tensor<2>| -> Vec<f32> { t.clone().into_data().iter::<f32>().collect() };
     Ok(SplatScene {
-        means: host(&gaussians.means),
+        means: host(gaussians.means.clone()),
         quaternions,
-        scales: host(&gaussians.scales),
+        scales: host(gaussians.scales.clone()),
         opacities: vec![OPACITY; gaussians.len()],
         sh_degree,
         sh,
@@ -216,7 +210,7 @@ pub fn bake_vertex_colours(
 /// canonical mesh V_s (pose-independent).
 pub fn vertex_colours(avatar: &Avatar, posed: &Posed) -> Result<Vec<[f32; 3]>, AvatarError> {
     let (degree, sh) = sh_coefficients(avatar, &posed.gaussians)?;
-    let personalised = rows3(posed.personalised.clone());
+    let personalised = host_rows(posed.personalised.clone());
     bake_vertex_colours(&personalised, &avatar.canonical.faces, Binding::of(avatar), &dc_colours(degree, &sh))
 }
 
@@ -225,10 +219,10 @@ pub fn vertex_colours(avatar: &Avatar, posed: &Posed) -> Result<Vec<[f32; 3]>, A
 /// correctives are not carried (glTF skinning is plain LBS); joints are named `joint_{k}`, as
 /// the canonical body stores no names.
 pub fn skinned_mesh(avatar: &Avatar, posed: &Posed) -> Result<SkinnedMesh, AvatarError> {
-    let mut mesh = TriMesh::new(rows3(posed.personalised.clone()), avatar.canonical.faces.clone());
+    let mut mesh = TriMesh::new(host_rows(posed.personalised.clone()), avatar.canonical.faces.clone());
     mesh.colors = Some(vertex_colours(avatar, posed)?);
     let bind_joints = match avatar.params.iter().find(|p| p.name == "joints") {
-        Some(p) => rows3(p.value.clone()),
+        Some(p) => host_rows(p.value.clone()),
         None => avatar.canonical.joints.clone(),
     };
     let j = avatar.canonical.num_joints();
@@ -370,7 +364,7 @@ mod tests {
         assert_eq!(baked.len(), 4);
         assert_colour(&baked, dc.map(|d| 0.5 + y00() * f64::from(d)));
         // The renderer's own colour path (degree 0: view-independent) agrees.
-        let rendered = rows3(avatar.colours(&posed.gaussians, [0.0, 0.0, 5.0]).unwrap());
+        let rendered = host_rows(avatar.colours(&posed.gaussians, [0.0, 0.0, 5.0]).unwrap());
         assert_colour(&baked, rendered[0].map(f64::from));
     }
 
@@ -472,7 +466,7 @@ mod tests {
         let posed = avatar.pose(&POSE, [0.0; 3]).unwrap();
         let scene = gaussian_scene(&avatar, &posed.gaussians).unwrap();
         assert_eq!((scene.sh_degree, scene.len()), (0, 4));
-        let rgb = rows3(avatar.colours(&posed.gaussians, [0.0; 3]).unwrap());
+        let rgb = host_rows(avatar.colours(&posed.gaussians, [0.0; 3]).unwrap());
         for (g, dc) in scene.sh.chunks_exact(3).enumerate() {
             for k in 0..3 {
                 let shown = 0.5 + y00() * f64::from(dc[k]);

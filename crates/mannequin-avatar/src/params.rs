@@ -17,6 +17,16 @@ pub struct Param {
     pub lr: f64,
 }
 
+/// A tensor's values on the host, row-major.
+pub fn host<const D: usize>(t: Tensor<D>) -> Vec<f32> {
+    t.into_data().iter::<f32>().collect()
+}
+
+/// The rows of an `[N, 3]` tensor on the host.
+pub fn host_rows(t: Tensor<2>) -> Vec<[f32; 3]> {
+    host(t).chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect()
+}
+
 /// Host copy of a tensor, for `.npz`.
 pub fn to_npy(t: &Tensor<2>) -> NpyArray {
     let [r, c] = t.dims();

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use burn::tensor::Tensor;
 use mannequin_data::{Dataset, DatasetWriter, DepthMap, Frame, Image, Mask, NormalMap};
 use mannequin_mesh::TriMesh;
 
 use crate::avatar::Avatar;
 use crate::error::AvatarError;
+use crate::params::{host, host_rows};
 use crate::views::frame_camera;
 
 /// A pixel belongs to the avatar where its alpha reaches this.
@@ -24,14 +24,6 @@ pub struct Prediction {
     pub mesh: TriMesh,
 }
 
-fn host(t: Tensor<2>) -> Vec<f32> {
-    t.into_data().iter::<f32>().collect()
-}
-
-fn host3(t: Tensor<3>) -> Vec<f32> {
-    t.into_data().iter::<f32>().collect()
-}
-
 /// Renders `avatar` at `pose`/`transl` through `camera`.
 pub fn predict(
     avatar: &Avatar,
@@ -43,8 +35,8 @@ pub fn predict(
     let r = avatar.render(&posed, camera)?;
     let (w, h) = (camera.width, camera.height);
     let n = w * h;
-    let rgb = host3(r.rgb);
-    let nrm = host3(r.normals);
+    let rgb = host(r.rgb);
+    let nrm = host(r.normals);
     let alpha = host(r.alpha);
     let depth = host(r.depth);
     let fg: Vec<bool> = alpha.iter().map(|&a| a >= FOREGROUND_ALPHA).collect();
@@ -59,7 +51,7 @@ pub fn predict(
         .collect();
     // The renderer's depth is Σ wᵢ zᵢ; over alpha it is the expected depth of the surface.
     let depth = (0..n).map(|p| if fg[p] { depth[p] / alpha[p] } else { 0.0 }).collect();
-    let positions = host(posed.vertices).chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect();
+    let positions = host_rows(posed.vertices);
     Ok(Prediction {
         image,
         mask: Mask { width: w, height: h, values: fg },

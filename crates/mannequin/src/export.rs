@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
+use mannequin_avatar::params::host_rows;
 use mannequin_avatar::{Avatar, Posed, export};
 use mannequin_body::{Motion, named_pose};
 use mannequin_mesh::TriMesh;
@@ -61,11 +62,6 @@ fn chosen_pose(args: &Args, joints: usize) -> Result<(Vec<f32>, [f32; 3])> {
     Ok((pose.to_vec(), [0.0; 3]))
 }
 
-fn host_rows(t: &burn::tensor::Tensor<2>) -> Vec<[f32; 3]> {
-    let flat: Vec<f32> = t.clone().into_data().iter::<f32>().collect();
-    flat.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect()
-}
-
 /// Whether `-o` names a skinned `.glb` (else `.obj` or `.ply`; anything else is an error).
 fn is_glb(path: &Path) -> Result<bool> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
@@ -84,7 +80,7 @@ fn write_output(avatar: &Avatar, posed: &Posed, canonical: bool, glb: bool, outp
             .with_context(|| format!("writing {}", output.display()));
     }
     let vertices = if canonical { &posed.personalised } else { &posed.vertices };
-    let mut mesh = TriMesh::new(host_rows(vertices), avatar.canonical.faces.clone());
+    let mut mesh = TriMesh::new(host_rows(vertices.clone()), avatar.canonical.faces.clone());
     mesh.colors = Some(export::vertex_colours(avatar, posed)?);
     write_mesh(output, &mesh)
 }
