@@ -125,10 +125,6 @@ fn image_tensor(
     Tensor::from_data(TensorData::new(values.to_vec(), [channels, crop.height, crop.width]), device)
 }
 
-fn crop3(t: Tensor<3>, crop: &crate::views::Crop) -> Tensor<3> {
-    t.narrow(1, crop.y, crop.height).narrow(2, crop.x, crop.width)
-}
-
 impl Trainer {
     pub fn new(avatar: Avatar, views: Vec<View>, options: TrainOptions) -> Result<Self, AvatarError> {
         if views.is_empty() {
@@ -214,20 +210,21 @@ impl Trainer {
         t.derivation = clock.elapsed();
         let clock = Instant::now();
         let posed = crate::avatar::Posed { personalised: personalised.clone(), vertices, gaussians };
-        let r = self.avatar.render(&posed, &view.camera)?;
+        // Only the crop is rendered: the losses look nowhere else.
+        let crop = &view.crop;
+        let r = self.avatar.render(&posed, &view.crop_camera())?;
         t.render = clock.elapsed();
 
         let clock = Instant::now();
-        let crop = &view.crop;
-        let pred = crop3(r.rgb, crop);
+        let pred = r.rgb;
         let target = image_tensor(&view.rgb, 3, crop, &device);
         let mse = (pred.clone() - target.clone()).square().mean();
         let mut loss = photometric(pred, target, o.lambda_ssim)?;
         if let Some(normals) = &view.normals {
             let target = image_tensor(normals, 3, crop, &device);
-            loss = loss + photometric(crop3(r.normals, crop), target, o.lambda_ssim)? * o.lambda_normal;
+            loss = loss + photometric(r.normals, target, o.lambda_ssim)? * o.lambda_normal;
         }
-        let alpha = r.alpha.narrow(0, crop.y, crop.height).narrow(1, crop.x, crop.width);
+        let alpha = r.alpha;
         let mask: Tensor<2> =
             Tensor::from_data(TensorData::new(view.mask.clone(), [crop.height, crop.width]), &device);
         loss = loss + (alpha - mask).abs().mean() * o.lambda_mask;
@@ -275,7 +272,7 @@ impl Trainer {
         let posed = crate::avatar::Posed { gaussians, ..posed };
         let mut total = Duration::ZERO;
         for _ in 0..repeats.max(1) {
-            let r = self.avatar.render(&posed, &view.camera)?;
+            let r = self.avatar.render(&posed, &view.crop_camera())?;
             let loss = r.rgb.sum() + r.normals.sum() + r.alpha.sum();
             let clock = Instant::now();
             let _ = loss.backward();

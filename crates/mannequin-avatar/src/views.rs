@@ -44,6 +44,14 @@ pub struct View {
     pub mask: Vec<f32>,
 }
 
+impl View {
+    /// The camera that renders just the crop.
+    pub fn crop_camera(&self) -> mannequin_splat::Camera {
+        let c = &self.crop;
+        self.camera.crop(c.x, c.y, c.width, c.height)
+    }
+}
+
 /// The mask's bounding box grown by the margin, clamped to the image, at least `MIN_CROP` wide.
 fn crop_of(mask: &mannequin_data::Mask) -> Crop {
     let (w, h) = (mask.width, mask.height);

@@ -81,6 +81,16 @@ impl Camera {
         Camera { intrinsic: k, width: self.width / factor, height: self.height / factor, ..self.clone() }
     }
 
+    /// The camera whose image is the `width`×`height` window at pixel `(x, y)` of this one: the
+    /// principal point moves by the offset, so every pixel sees exactly what it saw before and a
+    /// renderer spends nothing outside the window.
+    pub fn crop(&self, x: usize, y: usize, width: usize, height: usize) -> Self {
+        let mut k = self.intrinsic;
+        k[0][2] -= x as f64;
+        k[1][2] -= y as f64;
+        Camera { intrinsic: k, width, height, ..self.clone() }
+    }
+
     /// World→camera rotation `R`.
     pub fn rotation(&self) -> DMat3 {
         let e = &self.extrinsic;
