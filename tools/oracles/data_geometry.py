@@ -5,10 +5,13 @@ Writes, under crates/mannequin-data/tests/fixtures/:
   rounded to float32 so that both sides see the same numbers;
 - geometry.npz: surface samples of each (trimesh.sample.sample_surface: points and face ids) and
   the expected metrics on exactly those samples:
-  chamfer_cm = 100 * (mean_p min_q |p-q| + mean_q min_p |q-p|) / 2       (scipy cKDTree)
-  p2s_cm     = 100 * mean_p dist(p, gt surface)                           (igl.point_mesh_squared_distance)
+  chamfer_cm = 100 * (mean_p dist(p, gt surface) + mean_q dist(q, pred surface)) / 2
+                                                   (igl.point_mesh_squared_distance both ways)
+  p2s_cm     = 100 * mean_p dist(p, gt surface)    (the first half of the Chamfer sum)
   nc         = (mean_p |n_p . n_nn(p)| + mean_q |n_q . n_nn(q)|) / 2      (trimesh face normals)
   plus the per-point P2S distances and nearest GT faces for diagnosis.
+This is the Chamfer of PIFu, ICON and ECON (point-to-surface in both directions), which the
+clothed-human papers report; unlike point-to-point, it does not grow with the sample spacing.
 
 Run: $HOME/.cache/mannequin-oracles/bin/python tools/oracles/data_geometry.py
 """
@@ -49,12 +52,13 @@ def main():
     gs, gf = trimesh.sample.sample_surface(gt, n, seed=2)
     pn, gn = pred.face_normals[pf], gt.face_normals[gf]
 
-    d_pg, i_pg = cKDTree(gs).query(ps)
-    d_gp, i_gp = cKDTree(ps).query(gs)
-    chamfer = 100 * 0.5 * (d_pg.mean() + d_gp.mean())
+    _, i_pg = cKDTree(gs).query(ps)
+    _, i_gp = cKDTree(ps).query(gs)
     nc = 0.5 * (np.abs((pn * gn[i_pg]).sum(1)).mean() + np.abs((gn * pn[i_gp]).sum(1)).mean())
     sq, face, _ = igl.point_mesh_squared_distance(ps, gt.vertices, gt.faces.astype(np.int64))
+    sq_back, _, _ = igl.point_mesh_squared_distance(gs, pred.vertices, pred.faces.astype(np.int64))
     p2s = 100 * np.sqrt(sq).mean()
+    chamfer = 0.5 * (p2s + 100 * np.sqrt(sq_back).mean())
 
     np.savez_compressed(
         FIX / "geometry.npz",
