@@ -5,7 +5,7 @@
 use burn::tensor::Tensor;
 
 use crate::canonical::Canonical;
-use crate::mesh_gaussians::{GaussianGeometry, MeshIndex, normalise};
+use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, normalise};
 
 /// s1, the scale along the normal: 1 mm.
 pub const NORMAL_SCALE: f64 = 1e-3;
@@ -18,11 +18,11 @@ pub fn centroid_gaussians(
     rotation: Tensor<2>,
     log_scales: Tensor<2>,
 ) -> GaussianGeometry {
-    let [a, b, c] = index.corner_positions(vertices);
-    let means = (a.clone() + b.clone() + c.clone()) / 3.0;
-    let edge = b - a.clone();
-    let n = normalise(edge.clone().cross(c - a, 1)); // R0, Eq. 2
-    let r1 = normalise(edge); // Eq. 3
+    let faces = Faces::of(vertices, index);
+    let [a, b, c] = faces.corners;
+    let means = (a + b + c) / 3.0;
+    let n = normalise(faces.cross); // R0, Eq. 2
+    let r1 = normalise(faces.edge_ab); // Eq. 3
     let r2 = normalise(n.clone().cross(r1.clone(), 1)); // Eq. 4
     let z = normalise(rotation);
     let (cos, sin) = (z.clone().narrow(1, 0, 1), z.narrow(1, 1, 1));

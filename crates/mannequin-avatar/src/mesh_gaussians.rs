@@ -94,11 +94,6 @@ impl MeshIndex {
             valence,
         }
     }
-
-    /// The face corners of `vertices` [V, 3], each [F, 3].
-    pub fn corner_positions(&self, vertices: &Tensor<2>) -> [Tensor<2>; 3] {
-        self.corners.clone().map(|c| vertices.clone().select(0, c))
-    }
 }
 
 /// ‖x‖ per row, [N, 1].
@@ -122,22 +117,40 @@ fn disk_scales(in_plane: Tensor<2>) -> Tensor<2> {
     Tensor::cat(vec![in_plane.clone(), in_plane, eps], 1)
 }
 
-/// Face Gaussians (Eqs. 5–8) of posed vertices [V, 3].
-pub fn face_gaussians(vertices: &Tensor<2>, index: &MeshIndex) -> GaussianGeometry {
-    let [a, b, c] = index.corner_positions(vertices);
+/// What both bindings read of each face of a posed mesh, computed once: the corners, the edges
+/// a→b and a→c, and the unnormalised normal (b − a) × (c − a) = 2A·n.
+#[derive(Clone, Debug)]
+pub struct Faces {
+    pub corners: [Tensor<2>; 3],
+    pub edge_ab: Tensor<2>,
+    pub edge_ac: Tensor<2>,
+    pub cross: Tensor<2>,
+}
+
+impl Faces {
+    /// The faces of posed vertices [V, 3], each quantity [F, 3].
+    pub fn of(vertices: &Tensor<2>, index: &MeshIndex) -> Self {
+        let [a, b, c] = index.corners.clone().map(|c| vertices.clone().select(0, c));
+        let (edge_ab, edge_ac) = (b.clone() - a.clone(), c.clone() - a.clone());
+        let cross = edge_ab.clone().cross(edge_ac.clone(), 1);
+        Self { corners: [a, b, c], edge_ab, edge_ac, cross }
+    }
+}
+
+/// Face Gaussians (Eqs. 5–8) of a posed mesh's faces.
+pub fn face_gaussians(faces: &Faces) -> GaussianGeometry {
+    let [a, b, c] = faces.corners.clone();
     // Edge lengths opposite each corner.
     let la = row_norm(b.clone() - c.clone());
-    let lb = row_norm(c.clone() - a.clone());
-    let lc = row_norm(a.clone() - b.clone());
+    let lb = row_norm(faces.edge_ac.clone());
+    let lc = row_norm(faces.edge_ab.clone());
     let perimeter = la.clone() + lb.clone() + lc.clone();
     // Eq. 5: the incenter weights each corner by the length of the opposite edge.
-    let means = (a.clone() * la + b.clone() * lb + c.clone() * lc) / perimeter.clone();
-    let ab = b - a.clone();
-    let cross = ab.clone().cross(c - a, 1);
-    let double_area = row_norm(cross.clone());
+    let means = (a * la + b * lb + c * lc.clone()) / perimeter.clone();
+    let double_area = row_norm(faces.cross.clone());
     // Eqs. 6–7.
-    let n = cross / double_area.clone();
-    let t1 = normalise(ab);
+    let n = faces.cross.clone() / double_area.clone();
+    let t1 = faces.edge_ab.clone() / lc;
     let t2 = n.clone().cross(t1.clone(), 1);
     // Eq. 8: inradius r = A / s with s the semi-perimeter, so r = 2A / perimeter.
     let inradius = double_area / perimeter;
@@ -151,19 +164,18 @@ pub fn face_gaussians(vertices: &Tensor<2>, index: &MeshIndex) -> GaussianGeomet
 
 /// Area-weighted vertex normals (Eq. 9), [V, 3]: the sum of the adjacent faces' unnormalised
 /// cross products (each 2 A_f n_f), normalised.
-pub fn vertex_normals(vertices: &Tensor<2>, index: &MeshIndex) -> Tensor<2> {
-    let [a, b, c] = index.corner_positions(vertices);
-    let cross = (b - a.clone()).cross(c - a, 1);
-    let mut sum = vertices.zeros_like();
+pub fn vertex_normals(faces: &Faces, index: &MeshIndex) -> Tensor<2> {
+    let cross = &faces.cross;
+    let mut sum = Tensor::zeros([index.num_vertices, 3], (&cross.device(), cross.dtype()));
     for corner in &index.corners {
         sum = sum.select_assign(0, corner.clone(), cross.clone(), IndexingUpdateOp::Add);
     }
     normalise(sum)
 }
 
-/// Vertex Gaussians (Eqs. 9–11) of posed vertices [V, 3].
-pub fn vertex_gaussians(vertices: &Tensor<2>, index: &MeshIndex) -> GaussianGeometry {
-    let n = vertex_normals(vertices, index);
+/// Vertex Gaussians (Eqs. 9–11) of posed vertices [V, 3] and their faces.
+pub fn vertex_gaussians(vertices: &Tensor<2>, faces: &Faces, index: &MeshIndex) -> GaussianGeometry {
+    let n = vertex_normals(faces, index);
     // Eq. 10: the reference axis is the coordinate axis least aligned with the normal; the
     // choice is piecewise constant, so it carries no gradient.
     let axis = n.clone().detach().abs().argmin(1).reshape([index.num_vertices]);

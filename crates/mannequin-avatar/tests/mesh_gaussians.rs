@@ -3,7 +3,8 @@
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::mesh_gaussians::{
-    FACE_SCALE, MeshIndex, NORMAL_SCALE, VERTEX_SCALE, face_gaussians, vertex_gaussians, vertex_normals,
+    FACE_SCALE, Faces, MeshIndex, NORMAL_SCALE, VERTEX_SCALE, face_gaussians, vertex_gaussians,
+    vertex_normals,
 };
 
 fn vertices(v: &[[f64; 3]], device: &Device) -> Tensor<2> {
@@ -26,7 +27,7 @@ fn right_triangle_3_4_5_has_incenter_1_1_and_inradius_1() {
     let device = Device::flex();
     let v = vertices(&[[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]], &device);
     let index = MeshIndex::new(3, &[[0, 1, 2]], &device);
-    let g = face_gaussians(&v, &index);
+    let g = face_gaussians(&Faces::of(&v, &index));
     assert_eq!(values(g.means), vec![1.0, 1.0, 0.0]);
     let s = values(g.scales);
     assert!(close(s[0], FACE_SCALE, 1e-12) && close(s[1], FACE_SCALE, 1e-12), "{s:?}");
@@ -45,7 +46,7 @@ fn equilateral_triangle_incenter_is_centroid_and_inradius_is_side_over_2_sqrt3()
     let h = 3f64.sqrt() / 2.0;
     let v = vertices(&[[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.5, h, 1.0]], &device);
     let index = MeshIndex::new(3, &[[0, 1, 2]], &device);
-    let g = face_gaussians(&v, &index);
+    let g = face_gaussians(&Faces::of(&v, &index));
     let m = values(g.means);
     assert!(close(m[0], 0.5, 1e-12) && close(m[1], h / 3.0, 1e-12) && close(m[2], 1.0, 1e-12));
     let s = values(g.scales);
@@ -61,9 +62,9 @@ fn pyramid_apex_normal_points_up_and_scale_is_shortest_edge() {
     let faces = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]];
     let v = vertices(&pts, &device);
     let index = MeshIndex::new(5, &faces, &device);
-    let n = values(vertex_normals(&v, &index));
+    let n = values(vertex_normals(&Faces::of(&v, &index), &index));
     assert!(close(n[0], 0.0, 1e-12) && close(n[1], 0.0, 1e-12) && close(n[2], 1.0, 1e-12), "{n:?}");
-    let g = vertex_gaussians(&v, &index);
+    let g = vertex_gaussians(&v, &Faces::of(&v, &index), &index);
     let s = values(g.scales);
     assert!(close(s[0], VERTEX_SCALE * 3f64.sqrt(), 1e-12), "{s:?}");
     // A base corner's one ring: the apex (√3) and two base neighbours (2): the min is √3.
@@ -93,8 +94,9 @@ fn objective(v: &[[f64; 3]], faces: &[[u32; 3]], device: &Device) -> (Tensor<2>,
     let x = vertices(v, device);
     let x = if x.is_autodiff() { x.require_grad() } else { x };
     let index = MeshIndex::new(v.len(), faces, device);
-    let fg = face_gaussians(&x, &index);
-    let vg = vertex_gaussians(&x, &index);
+    let faces = Faces::of(&x, &index);
+    let fg = face_gaussians(&faces);
+    let vg = vertex_gaussians(&x, &faces, &index);
     let mut total: Option<Tensor<1>> = None;
     let mut k = 0.0;
     let mut add = |t: Tensor<2>| {
