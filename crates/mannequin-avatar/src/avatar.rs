@@ -14,7 +14,7 @@ use crate::config::{AvatarConfig, Method};
 use crate::error::AvatarError;
 use crate::field::Field;
 use crate::ihuman;
-use crate::mesh_gaussians::{GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
+use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
 use crate::params::{Param, tensor_from};
 use mannequin_data::rng::SplitMix64;
 
@@ -72,14 +72,25 @@ pub struct Posed {
     pub gaussians: GaussianGeometry,
 }
 
-/// Rendered maps: colour over white [3, H, W], camera-space normals over zero [3, H, W], alpha
-/// and expected depth [H, W].
+/// Rendered maps: colour over white and camera-space normals over zero, stacked as one
+/// [6, H, W] image (the losses read both at once), alpha and expected depth [H, W].
 #[derive(Clone, Debug)]
 pub struct Rendered {
-    pub rgb: Tensor<3>,
-    pub normals: Tensor<3>,
+    pub image: Tensor<3>,
     pub alpha: Tensor<2>,
     pub depth: Tensor<2>,
+}
+
+impl Rendered {
+    /// Colour over white [3, H, W].
+    pub fn rgb(&self) -> Tensor<3> {
+        self.image.clone().narrow(0, 0, 3)
+    }
+
+    /// Camera-space normals over zero [3, H, W].
+    pub fn normals(&self) -> Tensor<3> {
+        self.image.clone().narrow(0, 3, 3)
+    }
 }
 
 fn flat(v: &[[f32; 3]]) -> Vec<f32> {
@@ -122,7 +133,8 @@ impl Avatar {
                     slots.sh_rest = Some(params.len() - 1);
                 }
                 if !config.face_gaussians {
-                    let init = log_in_plane(vertex_gaussians(&vertices, &index));
+                    let faces = Faces::of(&vertices, &index);
+                    let init = log_in_plane(vertex_gaussians(&vertices, &faces, &index));
                     params.push(Param::new("vertex_log_scales", init, 1e-3));
                     slots.vertex_log_scales = Some(params.len() - 1);
                 }
@@ -131,7 +143,7 @@ impl Avatar {
                 let centroids = ihuman::face_centroids(&canonical);
                 colour_field =
                     Some(Field::new("colour", &config, &centroids, 3, 5e-4, &mut rng, device, &mut params)?);
-                let init = log_in_plane(face_gaussians(&vertices, &index));
+                let init = log_in_plane(face_gaussians(&Faces::of(&vertices, &index)));
                 params.push(Param::new("face_log_scales", init, 5e-3));
                 slots.face_log_scales = Some(params.len() - 1);
                 let identity: Vec<f32> = (0..f).flat_map(|_| [1.0, 0.0]).collect();
@@ -247,14 +259,15 @@ impl Avatar {
     pub fn bind(&self, vertices: &Tensor<2>) -> GaussianGeometry {
         match self.config.method {
             Method::Tavatar => {
+                let faces = Faces::of(vertices, &self.index);
                 let mut vertex =
-                    self.config.vertex_gaussians.then(|| vertex_gaussians(vertices, &self.index));
+                    self.config.vertex_gaussians.then(|| vertex_gaussians(vertices, &faces, &self.index));
                 if let (Some(vg), Some(ls)) = (vertex.as_mut(), self.param(self.slots.vertex_log_scales)) {
                     // Tavatar §5.3 "w/o FG": vertex scales become learnable.
                     let eps = vg.scales.clone().narrow(1, 2, 1);
                     vg.scales = Tensor::cat(vec![ls.exp(), eps], 1);
                 }
-                let face = self.config.face_gaussians.then(|| face_gaussians(vertices, &self.index));
+                let face = self.config.face_gaussians.then(|| face_gaussians(&faces));
                 match (face, vertex) {
                     (Some(f), Some(v)) => GaussianGeometry::cat(f, v),
                     (Some(f), None) => f,
@@ -339,12 +352,7 @@ impl Avatar {
             camera,
             &options,
         )?;
-        Ok(Rendered {
-            rgb: out.image.clone().narrow(0, 0, 3),
-            normals: out.image.narrow(0, 3, 3),
-            alpha: out.alpha,
-            depth: out.depth,
-        })
+        Ok(Rendered { image: out.image, alpha: out.alpha, depth: out.depth })
     }
 
     /// Writes `avatar.json` and `avatar.npz` (canonical body + parameters) into `dir`, each

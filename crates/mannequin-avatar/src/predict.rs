@@ -35,8 +35,8 @@ pub fn predict(
     let r = avatar.render(&posed, camera)?;
     let (w, h) = (camera.width, camera.height);
     let n = w * h;
-    let rgb = host(r.rgb);
-    let nrm = host(r.normals);
+    let rgb = host(r.rgb());
+    let nrm = host(r.normals());
     let alpha = host(r.alpha);
     let depth = host(r.depth);
     let fg: Vec<bool> = alpha.iter().map(|&a| a >= FOREGROUND_ALPHA).collect();

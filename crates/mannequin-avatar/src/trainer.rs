@@ -12,7 +12,7 @@ use crate::adam::Adam;
 use crate::avatar::Avatar;
 use crate::config::Method;
 use crate::error::AvatarError;
-use crate::losses::{MeshTopology, photometric};
+use crate::losses::{MeshTopology, photometric_weighted};
 use crate::views::View;
 
 /// Where Tavatar's learning rates end, as a fraction of their start. Constant rates leave the
@@ -216,14 +216,17 @@ impl Trainer {
         t.render = clock.elapsed();
 
         let clock = Instant::now();
-        let pred = r.rgb;
-        let target = image_tensor(&view.rgb, 3, crop, &device);
-        let mse = (pred.clone() - target.clone()).square().mean();
-        let mut loss = photometric(pred, target, o.lambda_ssim)?;
-        if let Some(normals) = &view.normals {
-            let target = image_tensor(normals, 3, crop, &device);
-            loss = loss + photometric(r.normals, target, o.lambda_ssim)? * o.lambda_normal;
-        }
+        // Eq. 12 on colour and Eq. 13 on normals in one pass over the stacked image.
+        let (target, weights) = match &view.normals {
+            Some(normals) => {
+                let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);
+                (image_tensor(&[view.rgb.as_slice(), normals].concat(), 6, crop, &device), w.collect())
+            }
+            None => (image_tensor(&view.rgb, 3, crop, &device), vec![1.0 / 3.0; 3]),
+        };
+        let pred = if view.normals.is_some() { r.image.clone() } else { r.rgb() };
+        let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
+        let mut loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
         let alpha = r.alpha;
         let mask: Tensor<2> =
             Tensor::from_data(TensorData::new(view.mask.clone(), [crop.height, crop.width]), &device);
@@ -273,7 +276,7 @@ impl Trainer {
         let mut total = Duration::ZERO;
         for _ in 0..repeats.max(1) {
             let r = self.avatar.render(&posed, &view.crop_camera())?;
-            let loss = r.rgb.sum() + r.normals.sum() + r.alpha.sum();
+            let loss = r.image.sum() + r.alpha.sum();
             let clock = Instant::now();
             let _ = loss.backward();
             total += clock.elapsed();

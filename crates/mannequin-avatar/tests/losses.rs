@@ -7,7 +7,8 @@
 use burn::tensor::{DType, Device, DeviceKind, Tensor, TensorData};
 use mannequin_avatar::AvatarError;
 use mannequin_avatar::losses::{
-    MeshTopology, gaussian_blur_valid, gaussian_window, photometric, ssim, ssim_map, ssim_with_blur,
+    MeshTopology, gaussian_blur_valid, gaussian_window, photometric, photometric_weighted, ssim, ssim_map,
+    ssim_with_blur,
 };
 use mannequin_data::Image;
 use mannequin_data::metrics::ssim::ssim as metric_ssim;
@@ -212,6 +213,38 @@ fn photometric_is_the_weighted_sum_and_has_the_right_gradient() {
         let target = tensor(&b, [3, h, w], &x.device(), DType::F64);
         photometric(x, target, 0.2).unwrap()
     });
+}
+
+#[test]
+fn weighted_photometric_of_stacked_maps_is_the_sum_of_their_losses() {
+    // Colour and normals stacked as six channels, weighted 1/3 and 0.05/3 per channel: the loss
+    // of Eq. 12 plus 0.05 times that of Eq. 13, each from the host SSIM metric and host L1.
+    let (h, w) = (13, 12);
+    let mut rng = SplitMix64::new(9);
+    let a = random_image(&mut rng, 6 * h * w);
+    let b = random_image(&mut rng, 6 * h * w);
+    let n = 3 * h * w;
+    let loss = |p: &[f64], q: &[f64]| {
+        let l1 = p.iter().zip(q).map(|(x, y)| (x - y).abs()).sum::<f64>() / p.len() as f64;
+        0.2 * (1.0 - metric_ssim(&image(p, h, w), &image(q, h, w))) + 0.8 * l1
+    };
+    let want = loss(&a[..n], &b[..n]) + 0.05 * loss(&a[n..], &b[n..]);
+    let weights = [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.05 / 3.0, 0.05 / 3.0, 0.05 / 3.0];
+    let device = Device::flex();
+    let got = photometric_weighted(
+        tensor(&a, [6, h, w], &device, DType::F64),
+        tensor(&b, [6, h, w], &device, DType::F64),
+        0.2,
+        &weights,
+    );
+    assert!((scalar(got.unwrap()) - want).abs() < 1e-12);
+    check_gradient("d weighted photometric / d pred", &a, [6, h, w], |x| {
+        let target = tensor(&b, [6, h, w], &x.device(), DType::F64);
+        photometric_weighted(x, target, 0.2, &weights).unwrap()
+    });
+    let zeros = Tensor::<3>::zeros([6, h, w], &device);
+    let err = photometric_weighted(zeros.clone(), zeros, 0.2, &weights[..3]).expect_err("an error");
+    assert!(err.to_string().contains("3 channel weights for images of 6 channels"), "{err}");
 }
 
 #[test]

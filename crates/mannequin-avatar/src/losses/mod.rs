@@ -12,6 +12,6 @@ mod ssim;
 mod topology;
 
 pub use blur::{BlurBackend, gaussian_blur_valid, gaussian_window};
-pub use photometric::{LAMBDA_SSIM, photometric};
+pub use photometric::{LAMBDA_SSIM, photometric, photometric_weighted};
 pub use ssim::{SsimBackend, ssim, ssim_map, ssim_with_blur};
 pub use topology::MeshTopology;
