@@ -342,7 +342,11 @@ impl Avatar {
             background: vec![WHITE[0], WHITE[1], WHITE[2], 0.0, 0.0, 0.0],
             ..RenderOptions::default()
         };
-        let opacities = Tensor::<1>::ones([n], &self.device);
+        let opacities = if self.config.antialiased {
+            crate::antialias::compensation(g, camera)
+        } else {
+            Tensor::<1>::ones([n], &self.device)
+        };
         let out = splat_render(
             g.means.clone(),
             RotationTensor::Matrices(g.frames.clone()),

@@ -43,6 +43,11 @@ pub struct AvatarConfig {
     pub hash_features: usize,
     /// Width of the MLPs' two hidden layers.
     pub hidden: usize,
+    /// gsplat's antialiased mode: opacities scaled by the screen filter's compensation
+    /// ([`crate::antialias`]), so silhouettes do not overshoot the mesh. Off by default (the
+    /// papers render with the plain 3DGS rule); models saved before it existed load without it.
+    #[serde(default)]
+    pub antialiased: bool,
     /// Seed of every random initialisation.
     pub seed: u64,
 }
@@ -67,6 +72,7 @@ impl AvatarConfig {
             // iHuman supplement §1.1: 4 features per entry; instant-ngp's default of 2 otherwise.
             hash_features: if method == Method::Ihuman { 4 } else { 2 },
             hidden: 64,
+            antialiased: false,
             seed,
         }
     }

@@ -3,6 +3,7 @@
 //! rendered by differentiable splatting.
 
 pub mod adam;
+pub mod antialias;
 pub mod avatar;
 pub mod canonical;
 pub mod colour_init;

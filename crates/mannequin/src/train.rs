@@ -50,6 +50,11 @@ pub struct Args {
     /// Ablation: no equilateral regulariser.
     #[arg(long)]
     pub no_equilateral: bool,
+    /// gsplat's antialiased mode: opacities scaled by the screen filter's compensation, so
+    /// silhouettes do not overshoot the mesh (on synthetic subject 0: Chamfer 0.51 → 0.48 cm,
+    /// but novel-view PSNR 32.3 → 31.1 dB and normal angle 6.4° → 9.0°).
+    #[arg(long)]
+    pub antialiased: bool,
     /// Start over even if the model folder holds a checkpoint.
     #[arg(long)]
     pub restart: bool,
@@ -58,6 +63,7 @@ pub struct Args {
 fn avatar_config(args: &Args) -> AvatarConfig {
     let mut config = AvatarConfig::new(args.method, args.seed);
     config.subdivisions = args.subdivide;
+    config.antialiased = args.antialiased;
     if args.method == Method::Tavatar {
         config.face_gaussians = !args.no_face_gaussians;
         config.vertex_gaussians = !args.no_vertex_gaussians;
