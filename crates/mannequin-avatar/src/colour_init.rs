@@ -30,7 +30,7 @@ pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f
         let normals = host(posed.gaussians.normals);
         let cam = &view.camera;
         let eye = cam.centre();
-        let (crop, n) = (view.crop, view.crop.width * view.crop.height);
+        let (crop, n, rgb) = (view.crop, view.crop.width * view.crop.height, view.rgb());
         for i in 0..g {
             let p = [0, 1, 2].map(|a| means[3 * i + a] as f64);
             let to_eye = [0, 1, 2].map(|a| eye[a] - p[a]);
@@ -59,7 +59,7 @@ pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f
                 continue;
             }
             for (ch, acc) in sum[i].iter_mut().enumerate() {
-                *acc += view.rgb[ch * n + q] as f64;
+                *acc += rgb[ch * n + q] as f64;
             }
             count[i] += 1;
         }

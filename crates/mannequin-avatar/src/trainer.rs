@@ -146,7 +146,7 @@ impl Trainer {
     }
 
     pub fn has_normals(&self) -> bool {
-        self.views.iter().all(|v| v.normals.is_some())
+        self.views.iter().all(|v| v.has_normals())
     }
 
     /// iHuman's three stages (supplement §1.3) over 20 "epochs" spread across the run: the
@@ -216,15 +216,14 @@ impl Trainer {
         t.render = clock.elapsed();
 
         let clock = Instant::now();
+        let target = image_tensor(&view.targets, view.target_channels(), crop, &device);
         // Eq. 12 on colour and Eq. 13 on normals in one pass over the stacked image.
-        let (target, weights) = match &view.normals {
-            Some(normals) => {
-                let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);
-                (image_tensor(&[view.rgb.as_slice(), normals].concat(), 6, crop, &device), w.collect())
-            }
-            None => (image_tensor(&view.rgb, 3, crop, &device), vec![1.0 / 3.0; 3]),
+        let (pred, weights) = if view.has_normals() {
+            let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);
+            (r.image.clone(), w.collect())
+        } else {
+            (r.rgb(), vec![1.0 / 3.0; 3])
         };
-        let pred = if view.normals.is_some() { r.image.clone() } else { r.rgb() };
         let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
         let mut loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
         let alpha = r.alpha;

@@ -36,15 +36,29 @@ pub struct View {
     pub pose: Vec<f32>,
     pub transl: [f32; 3],
     pub crop: Crop,
-    /// Target colour over white, [3, h, w] of the crop.
-    pub rgb: Vec<f32>,
-    /// Target camera-space normals (zero on the background), [3, h, w], where the dataset has them.
-    pub normals: Option<Vec<f32>>,
+    /// Targets over the crop, [C, h, w]: colour over white, then camera-space normals (zero on
+    /// the background) where the dataset has them (C = 6, else 3), stacked as the losses read
+    /// them.
+    pub targets: Vec<f32>,
     /// [h, w] in {0, 1}.
     pub mask: Vec<f32>,
 }
 
 impl View {
+    /// Channels of `targets`: 6 with normal maps, 3 without.
+    pub fn target_channels(&self) -> usize {
+        self.targets.len() / (self.crop.width * self.crop.height)
+    }
+
+    pub fn has_normals(&self) -> bool {
+        self.target_channels() == 6
+    }
+
+    /// Target colour over white, [3, h, w].
+    pub fn rgb(&self) -> &[f32] {
+        &self.targets[..3 * self.crop.width * self.crop.height]
+    }
+
     /// The camera that renders just the crop.
     pub fn crop_camera(&self) -> mannequin_splat::Camera {
         let c = &self.crop;
@@ -94,26 +108,26 @@ pub fn load_views(
         }
         let crop = crop_of(&f.mask);
         let (w, n) = (f.image.width, crop.width * crop.height);
-        let mut rgb = vec![0.0f32; 3 * n];
+        let channels = if f.normals.is_some() { 6 } else { 3 };
+        let mut targets = vec![0.0f32; channels * n];
         let mut mask = vec![0.0f32; n];
-        let mut normals = f.normals.as_ref().map(|_| vec![0.0f32; 3 * n]);
         for y in 0..crop.height {
             for x in 0..crop.width {
                 let (p, q) = ((crop.y + y) * w + crop.x + x, y * crop.width + x);
                 let fg = f.mask.values[p];
                 mask[q] = f32::from(u8::from(fg));
                 for c in 0..3 {
-                    rgb[c * n + q] = if fg { f.image.pixels[p][c] } else { 1.0 };
+                    targets[c * n + q] = if fg { f.image.pixels[p][c] } else { 1.0 };
                 }
-                if let (Some(out), Some(map)) = (normals.as_mut(), f.normals.as_ref()) {
+                if let Some(map) = &f.normals {
                     for c in 0..3 {
-                        out[c * n + q] = map.normals[p][c];
+                        targets[(3 + c) * n + q] = map.normals[p][c];
                     }
                 }
             }
         }
         let pose = split.poses.pose72(i);
-        views.push(View { frame, camera, pose, transl: split.poses.transl[i], crop, rgb, normals, mask });
+        views.push(View { frame, camera, pose, transl: split.poses.transl[i], crop, targets, mask });
         progress(i + 1, split.frames.len());
     }
     Ok(views)

@@ -109,7 +109,7 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
         progress.finish_and_clear();
         views
     };
-    if views.iter().any(|v| v.normals.is_none()) {
+    if views.iter().any(|v| !v.has_normals()) {
         tracing::warn!("{} has no normal maps: the normal loss is off", args.data.display());
     }
     let config = avatar_config(args);
