@@ -12,18 +12,11 @@ use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::hash_grid::{Aabb, HashGridConfig, HashGridLookup, encode, init_table};
 use mannequin_body::BodyModel;
 
+mod timing;
+
 /// Median wall time of `f` in milliseconds, after one warm-up call.
-fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
-    f();
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[reps / 2]
+fn median_ms(reps: usize, f: impl FnMut()) -> f64 {
+    timing::median_and_min_ms(reps, f).0
 }
 
 /// The encoding recomputed from the positions, as a direct reading of the paper would do it.

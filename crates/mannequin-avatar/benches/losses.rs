@@ -11,7 +11,9 @@
 //! `cargo bench -p mannequin-avatar --bench losses` (add `-- --quick` for fewer repetitions).
 //! Times are medians, with the fastest run in brackets (the CPU may be shared).
 
-use std::time::Instant;
+mod timing;
+
+use timing::median_and_min_ms;
 
 use burn::tensor::module::conv2d;
 use burn::tensor::ops::ConvOptions;
@@ -22,20 +24,6 @@ use mannequin_data::rng::SplitMix64;
 
 /// The trainer's whole per-iteration budget on the 2-core CPU.
 const BUDGET_MS: f64 = 150.0;
-
-/// Median and fastest wall time of `f` in milliseconds, after one warm-up run.
-fn time_ms(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
-    f();
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    (t[reps / 2], t[0])
-}
 
 fn window(shape: [usize; 4], values: Vec<f32>, device: &Device) -> Tensor<4> {
     Tensor::from_data(TensorData::new(values, shape), device)
@@ -107,7 +95,7 @@ fn ssim_section(reps: usize, device: &Device) {
         let (normals, normals_target) = pair(3, h, w, 8, device);
         let preds = [rgb, normals];
         let run_with = |f: &dyn Fn(Tensor<3>, Tensor<3>) -> Tensor<1>| {
-            time_ms(reps, || {
+            median_and_min_ms(reps, || {
                 forward_backward(&preds, |[a, b]| f(a, rgb_target.clone()) + f(b, normals_target.clone()))
             })
         };
@@ -123,11 +111,11 @@ fn ssim_section(reps: usize, device: &Device) {
     let (planes, _) = pair(6, 540, 540, 9, device);
     let planes = [planes];
     println!("  blur alone, 540×540×6, forward + backward:");
-    let conv = time_ms(reps, || forward_backward(&planes, |[x]| conv_blur_separable(x).sum()));
+    let conv = median_and_min_ms(reps, || forward_backward(&planes, |[x]| conv_blur_separable(x).sum()));
     print("conv2d 1×11 then 11×1", conv, None);
     print(
         "separable blur op",
-        time_ms(reps, || forward_backward(&planes, |[x]| gaussian_blur_valid(x).unwrap().sum())),
+        median_and_min_ms(reps, || forward_backward(&planes, |[x]| gaussian_blur_valid(x).unwrap().sum())),
         Some(conv.0),
     );
 }
@@ -145,7 +133,7 @@ fn mesh_section(reps: usize, device: &Device) {
         topology.num_faces()
     );
     let report = |name: &str, loss: &dyn Fn(Tensor<2>) -> Tensor<1>| {
-        let (median, min) = time_ms(reps, || forward_backward(&vertices, |[v]| loss(v)));
+        let (median, min) = median_and_min_ms(reps, || forward_backward(&vertices, |[v]| loss(v)));
         println!(
             "    {name:<36}{median:8.2} ms ({min:6.2})   {:5.1}% of the {BUDGET_MS} ms budget",
             100.0 * median / BUDGET_MS
