@@ -9,6 +9,7 @@
 use burn::tensor::{Tensor, TensorData};
 use mannequin_splat::{Camera, DILATION};
 
+use crate::avatar::rotation_transposed;
 use crate::mesh_gaussians::GaussianGeometry;
 
 /// Smallest compensation kept differentiable (a degenerate footprint has det Σ₂ = 0).
@@ -20,16 +21,12 @@ const MIN_RATIO: f64 = 1e-12;
 pub fn compensation(g: &GaussianGeometry, camera: &Camera) -> Tensor<1> {
     let device = g.means.device();
     let n = g.len();
-    let e = &camera.extrinsic;
-    let row = |i: usize| {
-        let w: Vec<f32> = (0..3).map(|j| e[i][j] as f32).collect();
-        Tensor::<2>::from_data(TensorData::new(w, [1, 3]), &device)
-    };
+    let rt = rotation_transposed(camera, &device);
+    // Row i of the rotation W is column i of Wᵀ.
+    let row = |i: usize| rt.clone().narrow(1, i, 1).reshape([1, 3]);
     let (w0, w1, w2) = (row(0), row(1), row(2));
-    let rt: Vec<f32> = (0..3).flat_map(|j| (0..3).map(move |i| e[i][j] as f32)).collect();
-    let t: Vec<f32> = (0..3).map(|i| e[i][3] as f32).collect();
-    let pc = g.means.clone().matmul(Tensor::from_data(TensorData::new(rt, [3, 3]), &device))
-        + Tensor::<2>::from_data(TensorData::new(t, [1, 3]), &device);
+    let t: Vec<f32> = (0..3).map(|i| camera.extrinsic[i][3] as f32).collect();
+    let pc = g.means.clone().matmul(rt.clone()) + Tensor::<2>::from_data(TensorData::new(t, [1, 3]), &device);
     let col = |k: usize| pc.clone().narrow(1, k, 1);
     let (x, y, z) = (col(0), col(1), col(2));
     let (fx, fy) = (camera.intrinsic[0][0], camera.intrinsic[1][1]);

@@ -93,6 +93,14 @@ impl Rendered {
     }
 }
 
+/// The camera's world→camera rotation transposed, [3, 3]: rows of world vectors times it are
+/// camera-space vectors.
+pub(crate) fn rotation_transposed(camera: &Camera, device: &Device) -> Tensor<2> {
+    let e = &camera.extrinsic;
+    let rt: Vec<f32> = (0..3).flat_map(|i| (0..3).map(move |j| e[j][i] as f32)).collect();
+    tensor_from(rt, 3, 3, device)
+}
+
 fn flat(v: &[[f32; 3]]) -> Vec<f32> {
     v.iter().flatten().copied().collect()
 }
@@ -334,9 +342,7 @@ impl Avatar {
         let g = &posed.gaussians;
         let n = g.len();
         let rgb = self.colours(g, camera.centre())?;
-        let r = camera.extrinsic;
-        let rt: Vec<f32> = (0..3).flat_map(|i| (0..3).map(move |j| r[j][i] as f32)).collect();
-        let normals_cam = g.normals.clone().matmul(tensor_from(rt, 3, 3, &self.device));
+        let normals_cam = g.normals.clone().matmul(rotation_transposed(camera, &self.device));
         let features = Tensor::cat(vec![rgb, normals_cam], 1);
         let options = RenderOptions {
             background: vec![WHITE[0], WHITE[1], WHITE[2], 0.0, 0.0, 0.0],
