@@ -125,7 +125,7 @@ def oracle(scene):
     w, h = int(scene["width"]), int(scene["height"])
     covars, _ = _quat_scale_to_covar_preci(quats, scales, compute_covar=True, compute_preci=False)
     radii, means2d, depths, conics, _ = _fully_fused_projection(
-        means, covars, viewmat[None], K[None], w, h, eps2d=0.3,
+        means, covars, viewmat[None], K[None], w, h, eps2d=float(scene["eps2d"]),
         near_plane=float(scene["near"]), far_plane=float(scene["far"]),
     )
     radii, means2d, depths, conics = radii[0], means2d[0], depths[0], conics[0]
@@ -191,6 +191,8 @@ def human_shell(rng):
         opacities=rng.uniform(0.5, 1.0, size=n),
         sh_degree=0, sh=sh_coeffs(rng, n, 0),
         background=np.array([1.0, 1.0, 1.0]),
+        # The screen filter avatars train with (mannequin_avatar::AVATAR_DILATION), not 3DGS's 0.3.
+        eps2d=0.1,
     )
     return s
 
@@ -246,7 +248,7 @@ def main():
     out_dir.mkdir(parents=True, exist_ok=True)
     for i, (name, make) in enumerate(SCENES.items()):
         rng = np.random.default_rng(1000 + i)
-        scene = make(rng)
+        scene = {"eps2d": 0.3, **make(rng)}
         for key in ("means", "quats", "scales", "opacities", "sh", "features", "K", "viewmat", "background"):
             if key in scene:
                 scene[key] = f32(scene[key])

@@ -1,13 +1,12 @@
 //! gsplat's antialiased mode (Mip-Splatting's 2D filter) for mesh-bound Gaussians: the renderer
-//! adds a 0.3 px² low-pass to every screen-space covariance, which at 540×540 (≈5.6 mm per pixel
-//! on a standing subject) widens each sub-pixel disk by about half a pixel. With opacity 1 the
-//! rendered silhouette then overshoots the mesh by ≈0.8 px, and fitting it to the mask shrinks
-//! the mesh by ≈5 mm everywhere. Scaling each opacity by `sqrt(det Σ₂ / det(Σ₂ + 0.3 I))`, as
-//! gsplat does outside its kernel (`opacities * compensations`), keeps a filtered Gaussian's
-//! total weight that of the unfiltered one, so coverage follows the surface.
+//! adds a low-pass variance `d` (px²) to every screen-space covariance, which widens each
+//! sub-pixel disk; with opacity 1 the rendered silhouette overshoots the mesh, and fitting it to
+//! the mask shrinks the mesh. Scaling each opacity by `sqrt(det Σ₂ / det(Σ₂ + d I))`, as gsplat
+//! does outside its kernel (`opacities * compensations`), keeps a filtered Gaussian's total
+//! weight that of the unfiltered one, so coverage follows the surface.
 
 use burn::tensor::{Tensor, TensorData};
-use mannequin_splat::{Camera, DILATION};
+use mannequin_splat::Camera;
 
 use crate::avatar::rotation_transposed;
 use crate::mesh_gaussians::GaussianGeometry;
@@ -17,8 +16,9 @@ const MIN_RATIO: f64 = 1e-12;
 
 /// The opacity factors `[G]` of Gaussians seen through `camera`: the EWA screen covariance
 /// `Σ₂ = T Tᵀ` with `T = J W R S` (J the perspective Jacobian at the camera-space mean, W the
-/// camera rotation, R S the Gaussian's scaled frame), as the renderer projects it.
-pub fn compensation(g: &GaussianGeometry, camera: &Camera) -> Tensor<1> {
+/// camera rotation, R S the Gaussian's scaled frame), as the renderer projects it, for the
+/// renderer's `dilation`.
+pub fn compensation(g: &GaussianGeometry, camera: &Camera, dilation: f64) -> Tensor<1> {
     let device = g.means.device();
     let n = g.len();
     let rt = rotation_transposed(camera, &device);
@@ -41,6 +41,6 @@ pub fn compensation(g: &GaussianGeometry, camera: &Camera) -> Tensor<1> {
     let dot = |a: &Tensor<2>, b: &Tensor<2>| (a.clone() * b.clone()).sum_dim(1);
     let (p, q, r) = (dot(&t0, &t0), dot(&t0, &t1), dot(&t1, &t1));
     let det = p.clone() * r.clone() - q.clone().square();
-    let det_filtered = (p + DILATION) * (r + DILATION) - q.square();
+    let det_filtered = (p + dilation) * (r + dilation) - q.square();
     (det / det_filtered).clamp_min(MIN_RATIO).sqrt().reshape([n])
 }

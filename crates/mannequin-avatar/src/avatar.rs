@@ -111,6 +111,12 @@ impl Avatar {
         if config.sh_degree > 2 {
             return Err(AvatarError::Invalid(format!("SH degree {} (0 to 2 supported)", config.sh_degree)));
         }
+        if !(config.dilation.is_finite() && config.dilation >= 0.0) {
+            return Err(AvatarError::Invalid(format!(
+                "screen-filter dilation {} px² (expected a finite value >= 0)",
+                config.dilation
+            )));
+        }
         if config.method == Method::Tavatar && !config.face_gaussians && !config.vertex_gaussians {
             return Err(AvatarError::Invalid(
                 "face and vertex Gaussians are both off: nothing to render".into(),
@@ -346,10 +352,11 @@ impl Avatar {
         let features = Tensor::cat(vec![rgb, normals_cam], 1);
         let options = RenderOptions {
             background: vec![WHITE[0], WHITE[1], WHITE[2], 0.0, 0.0, 0.0],
+            dilation: self.config.dilation,
             ..RenderOptions::default()
         };
         let opacities = if self.config.antialiased {
-            crate::antialias::compensation(g, camera)
+            crate::antialias::compensation(g, camera, self.config.dilation)
         } else {
             Tensor::<1>::ones([n], &self.device)
         };

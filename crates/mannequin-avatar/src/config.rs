@@ -2,6 +2,19 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The screen filter the avatar renders with (px², the renderer's `dilation`). 3DGS's 0.3 widens
+/// an edge-on opaque disk to alpha ½ at ≈0.65 px past the surface; fitting masks and colour then
+/// shrinks the mesh by that much (≈3.6 mm at 540×540 on a standing subject). 0.1 keeps the
+/// overshoot near 0.37 px while every disk stays wider than a pixel's spacing to sample. On
+/// synthetic subject 0 (2,000 iterations) Chamfer went 0.507 → 0.352 cm and novel-view PSNR
+/// 32.3 → 33.1 dB.
+pub const AVATAR_DILATION: f64 = 0.1;
+
+/// What models saved before the setting existed were trained with: the renderer's default.
+fn legacy_dilation() -> f64 {
+    mannequin_splat::DILATION
+}
+
 /// How Gaussians are bound to the mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -48,6 +61,9 @@ pub struct AvatarConfig {
     /// papers render with the plain 3DGS rule); models saved before it existed load without it.
     #[serde(default)]
     pub antialiased: bool,
+    /// Screen-filter variance in px² ([`AVATAR_DILATION`] for new avatars).
+    #[serde(default = "legacy_dilation")]
+    pub dilation: f64,
     /// Seed of every random initialisation.
     pub seed: u64,
 }
@@ -73,6 +89,7 @@ impl AvatarConfig {
             hash_features: if method == Method::Ihuman { 4 } else { 2 },
             hidden: 64,
             antialiased: false,
+            dilation: AVATAR_DILATION,
             seed,
         }
     }

@@ -24,7 +24,7 @@ pub mod views;
 
 pub use avatar::{Avatar, Posed, Rendered};
 pub use canonical::Canonical;
-pub use config::{AvatarConfig, Method};
+pub use config::{AVATAR_DILATION, AvatarConfig, Method};
 pub use error::AvatarError;
 pub use predict::{Prediction, predict, predict_split};
 pub use trainer::{StepStats, Timings, TrainOptions, Trainer};

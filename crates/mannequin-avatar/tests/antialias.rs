@@ -3,10 +3,11 @@
 //! unfiltered determinant follows on the host in f64.
 
 use burn::tensor::{Device, Tensor, TensorData};
+use mannequin_avatar::AVATAR_DILATION;
 use mannequin_avatar::antialias::compensation;
 use mannequin_avatar::mesh_gaussians::GaussianGeometry;
 use mannequin_data::rng::SplitMix64;
-use mannequin_splat::{Camera, Colors, DILATION, Gaussians, RenderOptions, Rotations, project_gaussians};
+use mannequin_splat::{Camera, Colors, Gaussians, RenderOptions, Rotations, project_gaussians};
 
 fn unit(v: [f64; 3]) -> [f64; 3] {
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -43,7 +44,10 @@ fn compensation_matches_the_renderers_projection() {
         opacities: &opacities,
         colors: Colors::Features { channels: 3, values: &colours },
     };
-    let projection = project_gaussians(&g, &camera, &RenderOptions::default()).unwrap();
+    // The avatar's own filter, so the renderer's `dilation` option is exercised too.
+    let dilation = AVATAR_DILATION;
+    let options = RenderOptions { dilation, ..RenderOptions::default() };
+    let projection = project_gaussians(&g, &camera, &options).unwrap();
 
     let device = Device::flex();
     let f32s = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<_>>();
@@ -54,7 +58,7 @@ fn compensation_matches_the_renderers_projection() {
         scales: rows(&scales),
         normals: rows(&vec![0.0; 3 * n]),
     };
-    let got: Vec<f32> = compensation(&geometry, &camera).into_data().try_to_vec().unwrap();
+    let got: Vec<f32> = compensation(&geometry, &camera, dilation).into_data().try_to_vec().unwrap();
     let (mut checked, mut small, mut large) = (0, 0, 0);
     for (i, &got) in got.iter().enumerate() {
         if projection.radii[2 * i] == 0 {
@@ -62,7 +66,7 @@ fn compensation_matches_the_renderers_projection() {
         }
         let [a, b, c] = [0, 1, 2].map(|k| projection.conics[3 * i + k]);
         let det_conic = a * c - b * b;
-        let (p, q, r) = (c / det_conic - DILATION, -b / det_conic, a / det_conic - DILATION);
+        let (p, q, r) = (c / det_conic - dilation, -b / det_conic, a / det_conic - dilation);
         let want = ((p * r - q * q) * det_conic).max(0.0).sqrt();
         let err = (f64::from(got) - want).abs();
         assert!(err < 2e-4 * want.max(1e-2), "Gaussian {i}: {got} vs {want}");
@@ -71,5 +75,5 @@ fn compensation_matches_the_renderers_projection() {
         large += usize::from(want > 0.9);
     }
     // Both regimes occur: thin or sub-pixel footprints lose most of their opacity, wide ones keep it.
-    assert!(checked > 150 && small > 10 && large > 10, "{checked} checked, {small} small, {large} large");
+    assert!(checked > 150 && small > 5 && large > 10, "{checked} checked, {small} small, {large} large");
 }

@@ -1,6 +1,6 @@
 //! EWA splatting of one Gaussian (Zwicker et al. 2002; 3DGS eq. 5): the camera-space covariance
-//! `Σ' = J W Σ Wᵀ Jᵀ` with the Jacobian `J` of the perspective map at the mean, plus a 0.3 px²
-//! low-pass, inverted to the conic that the compositor evaluates. Conventions follow gsplat 1.5
+//! `Σ' = J W Σ Wᵀ Jᵀ` with the Jacobian `J` of the perspective map at the mean, plus a low-pass
+//! variance on the diagonal (0.3 px² by default, gsplat's `eps2d`), inverted to the conic that the compositor evaluates. Conventions follow gsplat 1.5
 //! (`_fully_fused_projection`): the Jacobian uses `x/z`, `y/z` clamped to 1.3× the frustum, the
 //! screen extent is a 3.33σ box per axis, and Gaussians outside `(near, far)` are culled.
 //! The backward pass is the exact derivative of this forward map, written out by hand.
@@ -12,7 +12,8 @@ use crate::gaussians::{Colors, GaussianGrads, Gaussians, Rotations};
 use crate::real::Real;
 use crate::sh;
 
-/// Variance added to the screen-space covariance diagonal (the 0.3 px low-pass filter).
+/// Default variance (px²) added to the screen-space covariance diagonal: the low-pass filter of
+/// 3DGS and gsplat (`eps2d`). [`crate::RenderOptions::dilation`] overrides it.
 pub const DILATION: f64 = 0.3;
 
 /// gsplat's per-axis screen extent in standard deviations. It equals `sqrt(2 ln 255)` rounded up,
@@ -121,7 +122,7 @@ struct Ewa<T> {
     cov: [T; 3],
 }
 
-fn ewa<T: Real>(g: &Gaussians<T>, cam: &CameraParams<T>, i: usize) -> Option<Ewa<T>> {
+fn ewa<T: Real>(g: &Gaussians<T>, cam: &CameraParams<T>, dil: T, i: usize) -> Option<Ewa<T>> {
     let m = [g.means[3 * i], g.means[3 * i + 1], g.means[3 * i + 2]];
     let pcr = mat_vec(&cam.r, m);
     let pc = [pcr[0] + cam.t[0], pcr[1] + cam.t[1], pcr[2] + cam.t[2]];
@@ -150,7 +151,6 @@ fn ewa<T: Real>(g: &Gaussians<T>, cam: &CameraParams<T>, i: usize) -> Option<Ewa
         let (row, col) = (k / 3, k % 3);
         if row == 0 { j[0] * mc[col] + j[1] * mc[6 + col] } else { j[2] * mc[3 + col] + j[3] * mc[6 + col] }
     });
-    let dil = T::from_f64(DILATION);
     let p = t2[0] * t2[0] + t2[1] * t2[1] + t2[2] * t2[2] + dil;
     let q = t2[0] * t2[3] + t2[1] * t2[4] + t2[2] * t2[5];
     let r = t2[3] * t2[3] + t2[4] * t2[4] + t2[5] * t2[5] + dil;
@@ -189,9 +189,15 @@ pub(crate) fn extent_sigma(threshold: f64) -> Option<f64> {
     (threshold > 0.0).then(|| EXTENT_SIGMA.max((2.0 * (1.0 / threshold).ln()).sqrt()))
 }
 
-/// Projects every Gaussian (in parallel).
-pub fn project<T: Real>(g: &Gaussians<T>, cam: &CameraParams<T>, alpha_threshold: f64) -> Projection<T> {
+/// Projects every Gaussian (in parallel). `alpha_threshold` sets the screen extent and `dilation` is the low-pass variance (px²).
+pub fn project<T: Real>(
+    g: &Gaussians<T>,
+    cam: &CameraParams<T>,
+    alpha_threshold: f64,
+    dilation: f64,
+) -> Projection<T> {
     let n = g.len();
+    let dil = T::from_f64(dilation);
     let ch = g.channels();
     let extent = extent_sigma(alpha_threshold).map(T::from_f64);
     let mut means2d = vec![T::ZERO; 2 * n];
@@ -212,7 +218,7 @@ pub fn project<T: Real>(g: &Gaussians<T>, cam: &CameraParams<T>, alpha_threshold
                 if !g.is_finite(i) {
                     return 1usize;
                 }
-                let Some(e) = ewa(g, cam, i) else { return 0 };
+                let Some(e) = ewa(g, cam, dil, i) else { return 0 };
                 let [p, q, r] = e.cov;
                 let det = p * r - q * q;
                 if det.partial_cmp(&T::ZERO) != Some(std::cmp::Ordering::Greater) {
@@ -259,6 +265,7 @@ pub(crate) struct ScreenGrad<T> {
 pub(crate) fn project_vjp<T: Real>(
     g: &Gaussians<T>,
     cam: &CameraParams<T>,
+    dil: T,
     i: usize,
     sg: &ScreenGrad<T>,
     d_color: &[T],
@@ -267,7 +274,7 @@ pub(crate) fn project_vjp<T: Real>(
     out: GradRow<'_, T>,
 ) {
     out.opacity[0] = d_opacity;
-    let Some(e) = ewa(g, cam, i) else { return };
+    let Some(e) = ewa(g, cam, dil, i) else { return };
     let [p, q, r] = e.cov;
     let det = p * r - q * q;
     let (a, b, c) = (r / det, -q / det, p / det);

@@ -11,7 +11,7 @@ use crate::composite::{Packed, Rule, TILE_PIXELS, TileOut, TileRect, composite_t
 use crate::composite_vjp::{Replay, SCREEN_GRADS, TileGrads, composite_tile_vjp};
 use crate::gaussians::{GaussianGrads, Gaussians};
 use crate::planes::TilePlanes;
-use crate::project::{GradRow, ScreenGrad, project, project_vjp};
+use crate::project::{DILATION, GradRow, ScreenGrad, project, project_vjp};
 use crate::real::Real;
 use crate::tiles::{Tiles, bin};
 use crate::{SplatError, TILE, sh};
@@ -32,6 +32,10 @@ pub struct RenderOptions {
     pub min_transmittance: f64,
     /// Also return how many Gaussians each pixel composited.
     pub count_contributors: bool,
+    /// Variance (px²) added to every screen-space covariance: the low-pass filter that keeps
+    /// sub-pixel Gaussians from falling between pixel centres ([`DILATION`], 0.3, as 3DGS).
+    /// It also widens every silhouette by about `sqrt(2 ln 2 · dilation)` px at alpha ½.
+    pub dilation: f64,
 }
 
 impl Default for RenderOptions {
@@ -42,6 +46,7 @@ impl Default for RenderOptions {
             max_alpha: 0.99,
             min_transmittance: 1e-4,
             count_contributors: false,
+            dilation: DILATION,
         }
     }
 }
@@ -72,6 +77,9 @@ impl RenderOptions {
         }
         if !(0.0..1.0).contains(&self.min_transmittance) {
             return err(format!("min_transmittance {} is outside [0, 1)", self.min_transmittance));
+        }
+        if !(self.dilation.is_finite() && self.dilation >= 0.0) {
+            return err(format!("dilation {} px² is not a finite variance >= 0", self.dilation));
         }
         Ok(())
     }
@@ -157,7 +165,7 @@ pub(crate) fn prepare<T: Real>(
     values: bool,
 ) -> Result<(Prepared<T>, usize), SplatError> {
     validate(g, camera, opts, values)?;
-    let projection = project(g, &CameraParams::new(camera), opts.alpha_threshold);
+    let projection = project(g, &CameraParams::new(camera), opts.alpha_threshold, opts.dilation);
     let tiles = bin(&projection, g.opacities, opts.alpha_threshold, camera.width, camera.height);
     let packed = Packed::new(&projection, g.opacities, g.channels(), opts.alpha_threshold, &tiles.order);
     Ok((Prepared { packed, tiles }, projection.skipped))
@@ -171,7 +179,7 @@ pub fn project_gaussians<T: Real>(
     opts: &RenderOptions,
 ) -> Result<crate::Projection<T>, SplatError> {
     validate(g, camera, opts, true)?;
-    Ok(project(g, &CameraParams::new(camera), opts.alpha_threshold))
+    Ok(project(g, &CameraParams::new(camera), opts.alpha_threshold, opts.dilation))
 }
 
 /// Renders the Gaussians through the camera.
@@ -364,7 +372,7 @@ pub(crate) fn backward_checked<T: Real>(
     let bufs: Vec<Vec<T>> =
         bufs.into_iter().map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
     let parts: Vec<&[T]> = bufs.iter().map(Vec::as_slice).collect();
-    Ok(screen_vjp(g, camera, &tiles.order, &parts, ch))
+    Ok(screen_vjp(g, camera, opts.dilation, &tiles.order, &parts, ch))
 }
 
 /// Chains screen-space gradients back to every Gaussian's parameters. `parts` hold, by depth
@@ -372,6 +380,7 @@ pub(crate) fn backward_checked<T: Real>(
 pub(crate) fn screen_vjp<T: Real>(
     g: &Gaussians<T>,
     camera: &Camera,
+    dilation: f64,
     order: &[u32],
     parts: &[&[T]],
     channels: usize,
@@ -382,7 +391,7 @@ pub(crate) fn screen_vjp<T: Real>(
     for (r, &i) in order.iter().enumerate() {
         rank[i as usize] = r as u32;
     }
-    let cam = CameraParams::new(camera);
+    let (cam, dil) = (CameraParams::new(camera), T::from_f64(dilation));
     let mut out_grads = GaussianGrads::zeros_like(g);
     let (rot_n, col_n) = (out_grads.rotations.len() / n.max(1), out_grads.colors.len() / n.max(1));
     let GaussianGrads { means, rotations, scales, opacities, colors } = &mut out_grads;
@@ -413,7 +422,7 @@ pub(crate) fn screen_vjp<T: Real>(
                 let sg =
                     ScreenGrad { mean2d: [sum[0], sum[1]], conic: [sum[2], sum[3], sum[4]], depth: sum[6] };
                 let row = GradRow { means: m, rotations: r, scales: s, opacity: o, colors: c };
-                project_vjp(g, &cam, i, &sg, &sum[SCREEN_GRADS..], sum[5], basis, row);
+                project_vjp(g, &cam, dil, i, &sg, &sum[SCREEN_GRADS..], sum[5], basis, row);
             },
         );
     out_grads

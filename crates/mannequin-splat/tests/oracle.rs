@@ -38,6 +38,7 @@ impl Fixture {
         RenderOptions {
             background: self.get("background"),
             count_contributors: true,
+            dilation: self.get("eps2d")[0],
             ..RenderOptions::default()
         }
     }
@@ -97,22 +98,23 @@ impl<T: Real> Inputs<T> {
     }
 }
 
-fn assert_close<T: Real>(what: &str, got: &[T], want: &[f64], tol: f64) {
+/// The most one Gaussian skipped or kept at the 1/255 alpha threshold can move a pixel: its
+/// alpha (< 1/255) times a colour difference (< 2 in these scenes).
+const THRESHOLD_FLIP: f64 = 2.0 / 255.0;
+
+/// Every value within `tol`, except up to `flips` values within [`THRESHOLD_FLIP`].
+fn assert_close<T: Real>(what: &str, got: &[T], want: &[f64], tol: f64, flips: usize) {
     assert_eq!(got.len(), want.len(), "{what}: length");
-    let mut worst = (0.0f64, 0usize);
-    for (i, (g, w)) in got.iter().zip(want).enumerate() {
-        let e = (g.to_f64() - w).abs();
-        if e > worst.0 {
-            worst = (e, i);
-        }
-    }
+    let errors: Vec<f64> = got.iter().zip(want).map(|(g, w)| (g.to_f64() - w).abs()).collect();
+    let (worst, at) =
+        errors.iter().enumerate().fold((0.0f64, 0), |m, (i, &e)| if e > m.0 { (e, i) } else { m });
+    let over = errors.iter().filter(|&&e| e > tol).count();
+    let bound = if flips > 0 { THRESHOLD_FLIP } else { tol };
     assert!(
-        worst.0 <= tol,
-        "{what}: worst error {:.3e} at {} (got {:?}, want {})",
-        worst.0,
-        worst.1,
-        got[worst.1],
-        want[worst.1]
+        over <= flips && worst <= bound,
+        "{what}: {over} values over {tol:.0e} (allowed {flips}); worst error {worst:.3e} at {at} (got {:?}, want {})",
+        got[at],
+        want[at]
     );
 }
 
@@ -160,15 +162,18 @@ fn check_images<T: Real>(name: &str, matrices: bool) {
         std::any::type_name::<T>(),
         if matrices { "matrices" } else { "quaternions" }
     );
-    assert_close(&format!("{what} image"), &out.image, &f.get("image"), 1e-4);
-    assert_close(&format!("{what} alpha"), &out.alpha, &f.get("alpha"), 1e-4);
-    assert_close(&format!("{what} depth"), &out.depth, &f.get("depth"), 1e-4);
+    // In f32 a pixel may stop one Gaussian earlier or later where transmittance lands within
+    // rounding of 1e-4 (the image moves by at most 1e-4 then), or skip or keep a Gaussian whose
+    // alpha lands within rounding of 1/255; in f64 everything must agree.
+    let npx = out.alpha.len();
+    let allowed = if std::mem::size_of::<T>() == 8 { 0 } else { npx / 500 };
+    let channels = out.image.len() / npx;
+    assert_close(&format!("{what} image"), &out.image, &f.get("image"), 1e-4, allowed * channels);
+    assert_close(&format!("{what} alpha"), &out.alpha, &f.get("alpha"), 1e-4, allowed);
+    assert_close(&format!("{what} depth"), &out.depth, &f.get("depth"), 1e-4, allowed);
     let count: Vec<f64> = out.count.unwrap().iter().map(|&c| c as f64).collect();
     let want = f.get("count");
     let differ = count.iter().zip(&want).filter(|(a, b)| a != b).count();
-    // In f32 a pixel may stop one Gaussian earlier or later where transmittance lands within
-    // rounding of 1e-4 (the image moves by at most 1e-4 then); in f64 counts must agree.
-    let allowed = if std::mem::size_of::<T>() == 8 { 0 } else { count.len() / 500 };
     assert!(differ <= allowed, "{what}: {differ} pixels composited a different number of Gaussians");
 }
 

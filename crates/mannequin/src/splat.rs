@@ -45,6 +45,9 @@ enum Verb {
         /// Output PNG.
         #[arg(short, long)]
         output: PathBuf,
+        /// Screen-filter variance in px² (3DGS viewers use 0.3; Mannequin avatars train with 0.1).
+        #[arg(long, default_value_t = mannequin_splat::DILATION)]
+        dilation: f64,
     },
     /// Print what a 3DGS `.ply` holds: count, SH degree, bounds, opacities and scales.
     Info {
@@ -55,7 +58,7 @@ enum Verb {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     match args.verb {
-        Verb::Render { ply, camera, output } => render_to_png(&ply, &camera, &output),
+        Verb::Render { ply, camera, output, dilation } => render_to_png(&ply, &camera, &output, dilation),
         Verb::Info { file } => info(&file),
     }
 }
@@ -120,11 +123,11 @@ pub fn read_camera(path: &Path) -> anyhow::Result<(Camera, Vec<f64>)> {
     Ok((camera, background))
 }
 
-fn render_to_png(ply: &Path, camera: &Path, output: &Path) -> anyhow::Result<()> {
+fn render_to_png(ply: &Path, camera: &Path, output: &Path, dilation: f64) -> anyhow::Result<()> {
     let _timer = JobTimer::start("splat render");
     let scene = SplatScene::read_ply(ply)?;
     let (camera, background) = read_camera(camera)?;
-    let opts = RenderOptions { background, ..RenderOptions::default() };
+    let opts = RenderOptions { background, dilation, ..RenderOptions::default() };
     let out =
         render(&scene.gaussians(), &camera, &opts).with_context(|| format!("rendering {}", ply.display()))?;
     if out.skipped > 0 {
@@ -249,7 +252,7 @@ mod tests {
         let (ply, cam, png) = (dir.join("s.ply"), dir.join("c.json"), dir.join("o.png"));
         scene.write_ply(&ply).unwrap();
         std::fs::write(&cam, CAMERA).unwrap();
-        run(Args { verb: Verb::Render { ply, camera: cam, output: png.clone() } }).unwrap();
+        run(Args { verb: Verb::Render { ply, camera: cam, output: png.clone(), dilation: 0.3 } }).unwrap();
         let img = mannequin_data::Image::read_png(&png).unwrap();
         assert_eq!((img.width, img.height), (32, 24));
         assert_eq!(img.at(0, 0), [0.0, 0.0, 1.0]);

@@ -51,10 +51,13 @@ pub struct Args {
     #[arg(long)]
     pub no_equilateral: bool,
     /// gsplat's antialiased mode: opacities scaled by the screen filter's compensation, so
-    /// silhouettes do not overshoot the mesh (on synthetic subject 0: Chamfer 0.51 → 0.48 cm,
-    /// but novel-view PSNR 32.3 → 31.1 dB and normal angle 6.4° → 9.0°).
+    /// silhouettes do not overshoot the mesh (costs novel-view PSNR and normal accuracy).
     #[arg(long)]
     pub antialiased: bool,
+    /// Screen-filter variance in px² added to every Gaussian's footprint (3DGS uses 0.3; larger
+    /// values widen silhouettes and shrink the fitted mesh).
+    #[arg(long, default_value_t = mannequin_avatar::AVATAR_DILATION)]
+    pub dilation: f64,
     /// Start over even if the model folder holds a checkpoint.
     #[arg(long)]
     pub restart: bool,
@@ -64,6 +67,7 @@ fn avatar_config(args: &Args) -> AvatarConfig {
     let mut config = AvatarConfig::new(args.method, args.seed);
     config.subdivisions = args.subdivide;
     config.antialiased = args.antialiased;
+    config.dilation = args.dilation;
     if args.method == Method::Tavatar {
         config.face_gaussians = !args.no_face_gaussians;
         config.vertex_gaussians = !args.no_vertex_gaussians;

@@ -166,8 +166,9 @@ fn export_writes_meshes_glb_and_splats() {
     close(&scene.means, &host(posed.gaussians.means), 1e-5, "Gaussian means");
     assert!(scene.opacities.iter().all(|&o| o > 0.9999));
 
-    // A splat viewer sees what the avatar renders: the file through `splat render` and the avatar
-    // through `render`, same frame and camera (white background), give the same 8-bit image.
+    // A splat viewer with the avatar's screen filter sees what the avatar renders: the file
+    // through `splat render` and the avatar through `render`, same frame and camera (white
+    // background), give the same 8-bit image.
     let camera = out.join("camera.json");
     std::fs::write(
         &camera,
@@ -176,7 +177,19 @@ fn export_writes_meshes_glb_and_splats() {
     )
     .unwrap();
     let (from_file, from_avatar) = (out.join("file.png"), out.join("avatar.png"));
-    ok(mannequin(&["splat", "render", "--ply", s(&splats), "--camera", s(&camera), "-o", s(&from_file)]));
+    let dilation = mannequin_avatar::AVATAR_DILATION.to_string();
+    ok(mannequin(&[
+        "splat",
+        "render",
+        "--ply",
+        s(&splats),
+        "--camera",
+        s(&camera),
+        "--dilation",
+        &dilation,
+        "-o",
+        s(&from_file),
+    ]));
     ok(mannequin(&[
         "render",
         "--model",

@@ -54,7 +54,7 @@ fn params(config: &SplatConfig, like: &CubeTensor) -> CubeTensor {
 }
 
 fn camera(config: &SplatConfig, like: &CubeTensor) -> CubeTensor {
-    upload(camera_words(&CameraParams::new(&config.camera), config.options.alpha_threshold), like)
+    upload(camera_words(&CameraParams::new(&config.camera), &config.options), like)
 }
 
 pub(super) fn u32_of(v: usize) -> u32 {

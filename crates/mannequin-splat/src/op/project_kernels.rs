@@ -10,18 +10,19 @@ use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
 use crate::camera::CameraParams;
-use crate::project::{DILATION, extent_sigma};
+use crate::project::extent_sigma;
+use crate::render::RenderOptions;
 
 /// Camera words: fx, fy, cx, cy, R (9, row-major), t (3), centre (3), near, far, width,
 /// height, x/z limits (−, +), y/z limits (−, +), extent in σ (0: unbounded), dilation.
-pub(crate) fn camera_words(cam: &CameraParams<f32>, alpha_threshold: f64) -> Vec<f32> {
+pub(crate) fn camera_words(cam: &CameraParams<f32>, options: &RenderOptions) -> Vec<f32> {
     let mut w = vec![cam.fx, cam.fy, cam.cx, cam.cy];
     w.extend_from_slice(&cam.r);
     w.extend_from_slice(&cam.t);
     w.extend_from_slice(&cam.centre);
     w.extend([cam.near, cam.far, cam.width, cam.height, cam.lim_x.0, cam.lim_x.1, cam.lim_y.0, cam.lim_y.1]);
-    w.push(extent_sigma(alpha_threshold).unwrap_or(0.0) as f32);
-    w.push(DILATION as f32);
+    w.push(extent_sigma(options.alpha_threshold).unwrap_or(0.0) as f32);
+    w.push(options.dilation as f32);
     w
 }
 
