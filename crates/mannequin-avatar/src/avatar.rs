@@ -13,6 +13,7 @@ use crate::canonical::Canonical;
 use crate::config::{AvatarConfig, Method};
 use crate::error::AvatarError;
 use crate::field::Field;
+use crate::fused_binding::{self, BindConfig};
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
 use crate::params::{Param, tensor_from};
@@ -273,21 +274,31 @@ impl Avatar {
     pub fn bind(&self, vertices: &Tensor<2>) -> GaussianGeometry {
         match self.config.method {
             Method::Tavatar => {
-                let faces = Faces::of(vertices, &self.index);
-                let mut vertex =
-                    self.config.vertex_gaussians.then(|| vertex_gaussians(vertices, &faces, &self.index));
-                if let (Some(vg), Some(ls)) = (vertex.as_mut(), self.param(self.slots.vertex_log_scales)) {
-                    // Tavatar §5.3 "w/o FG": vertex scales become learnable.
-                    let eps = vg.scales.clone().narrow(1, 2, 1);
-                    vg.scales = Tensor::cat(vec![ls.exp(), eps], 1);
+                let mut g = if fused_binding::supported(&self.device) {
+                    let config = BindConfig {
+                        topology: self.index.topology.clone(),
+                        face_gaussians: self.config.face_gaussians,
+                        vertex_gaussians: self.config.vertex_gaussians,
+                    };
+                    fused_binding::bind(vertices.clone(), &config)
+                } else {
+                    let faces = Faces::of(vertices, &self.index);
+                    let vertex =
+                        self.config.vertex_gaussians.then(|| vertex_gaussians(vertices, &faces, &self.index));
+                    let face = self.config.face_gaussians.then(|| face_gaussians(&faces));
+                    match (face, vertex) {
+                        (Some(f), Some(v)) => GaussianGeometry::cat(f, v),
+                        (Some(f), None) => f,
+                        (None, Some(v)) => v,
+                        (None, None) => unreachable!("rejected in Avatar::new"),
+                    }
+                };
+                if let Some(ls) = self.param(self.slots.vertex_log_scales) {
+                    // Tavatar §5.3 "w/o FG": only vertex Gaussians, whose scales become learnable.
+                    let eps = g.scales.clone().narrow(1, 2, 1);
+                    g.scales = Tensor::cat(vec![ls.exp(), eps], 1);
                 }
-                let face = self.config.face_gaussians.then(|| face_gaussians(&faces));
-                match (face, vertex) {
-                    (Some(f), Some(v)) => GaussianGeometry::cat(f, v),
-                    (Some(f), None) => f,
-                    (None, Some(v)) => v,
-                    (None, None) => unreachable!("rejected in Avatar::new"),
-                }
+                g
             }
             Method::Ihuman => ihuman::centroid_gaussians(
                 vertices,

@@ -12,6 +12,7 @@ pub mod error;
 pub mod evaluation;
 pub mod export;
 pub mod field;
+pub mod fused_binding;
 pub mod hash_grid;
 pub mod ihuman;
 pub mod losses;

@@ -2,7 +2,11 @@
 //! mesh, so every geometric attribute follows the surface and carries gradients back to the
 //! vertices (and from there to the offset field E_s).
 
+use std::sync::Arc;
+
 use burn::tensor::{Device, IndexingUpdateOp, Int, Tensor, TensorData};
+
+use crate::fused_binding::Topology;
 
 /// In-plane scale factor of face Gaussians, β in Eq. 8.
 pub const FACE_SCALE: f64 = 0.5;
@@ -12,7 +16,7 @@ pub const VERTEX_SCALE: f64 = 0.5;
 pub const NORMAL_SCALE: f64 = 1e-3;
 
 /// Keeps norms differentiable at zero-length vectors (degenerate faces).
-const NORM_EPS: f64 = 1e-20;
+pub(crate) const NORM_EPS: f64 = 1e-20;
 
 /// Gaussian geometry on a device: centres [G, 3], frames [G, 3, 3] whose columns are
 /// (t1, t2, n), scales [G, 3], and the unit normal [G, 3] (the third column, kept for normal
@@ -46,7 +50,8 @@ impl GaussianGeometry {
 }
 
 /// Index tensors of a fixed-topology mesh: the three corners of every face, and each vertex's
-/// one-ring padded to the largest valence (padding marked in `ring_pad`).
+/// one-ring padded to the largest valence (padding marked in `ring_pad`); and the same on the
+/// host for the fused binding.
 #[derive(Clone, Debug)]
 pub struct MeshIndex {
     pub num_vertices: usize,
@@ -56,6 +61,7 @@ pub struct MeshIndex {
     /// [V, valence], 1 where `ring` is padding.
     pub ring_pad: Tensor<2>,
     pub valence: usize,
+    pub topology: Arc<Topology>,
 }
 
 impl MeshIndex {
@@ -65,22 +71,12 @@ impl MeshIndex {
             let idx: Vec<i64> = faces.iter().map(|f| f[k] as i64).collect();
             Tensor::<1, Int>::from_data(TensorData::new(idx, [faces.len()]), device)
         };
-        let mut rings: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
-        for f in faces {
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                rings[a as usize].push(b);
-                rings[b as usize].push(a);
-            }
-        }
-        for r in &mut rings {
-            r.sort_unstable();
-            r.dedup();
-        }
-        let valence = rings.iter().map(Vec::len).max().unwrap_or(0).max(1);
+        let topology = Topology::new(num_vertices, faces);
+        let valence = topology.valence();
         let mut ring = Vec::with_capacity(num_vertices * valence);
         let mut pad = Vec::with_capacity(num_vertices * valence);
-        for (v, r) in rings.iter().enumerate() {
+        for v in 0..num_vertices {
+            let r = topology.ring(v);
             for k in 0..valence {
                 ring.push(r.get(k).map_or(v as i64, |&n| n as i64));
                 pad.push(if k < r.len() { 0.0f32 } else { 1.0 });
@@ -92,6 +88,7 @@ impl MeshIndex {
             ring: Tensor::from_data(TensorData::new(ring, [num_vertices * valence]), device),
             ring_pad: Tensor::from_data(TensorData::new(pad, [num_vertices, valence]), device),
             valence,
+            topology: Arc::new(topology),
         }
     }
 }

@@ -1,0 +1,112 @@
+//! Tavatar's binding (Eqs. 5–11) as one differentiable op with a hand-written backward, on Flex
+//! (CPU). Composed from tensor ops ([`crate::mesh_gaussians`]) the binding costs ~100 small
+//! allocating ops forward and as many backward, a fifth of a CPU training step; here it is one
+//! pass over faces and one over vertices each way. Other backends keep the tensor composition,
+//! which a GPU runs well: [`supported`] says which applies, and the tests hold the two to the
+//! same values and gradients.
+
+mod autodiff;
+mod flex;
+mod host;
+
+use std::sync::Arc;
+
+use burn::backend::tensor::FloatTensor;
+use burn::backend::{Backend, Dispatch, backend_extension};
+use burn::tensor::{Device, Tensor};
+
+use crate::mesh_gaussians::GaussianGeometry;
+
+/// Values per Gaussian in the op's output: mean (3), frame (9, row-major with columns t1, t2, n),
+/// scales (3) and the normal (3, the frame's third column again, for normal rendering).
+pub const PACKED: usize = 18;
+
+/// A fixed mesh's faces and one-rings (each ring sorted, as `MeshIndex` pads them).
+#[derive(Debug)]
+pub struct Topology {
+    pub num_vertices: usize,
+    pub faces: Vec<[u32; 3]>,
+    ring_start: Vec<usize>,
+    rings: Vec<u32>,
+}
+
+impl Topology {
+    /// Faces must already be validated against `num_vertices`.
+    pub fn new(num_vertices: usize, faces: &[[u32; 3]]) -> Self {
+        let mut rings: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
+        for f in faces {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                rings[a as usize].push(b);
+                rings[b as usize].push(a);
+            }
+        }
+        let mut ring_start = vec![0];
+        for r in &mut rings {
+            r.sort_unstable();
+            r.dedup();
+            ring_start.push(ring_start.last().copied().unwrap_or(0) + r.len());
+        }
+        Self { num_vertices, faces: faces.to_vec(), ring_start, rings: rings.concat() }
+    }
+
+    /// Vertex `i`'s neighbours, ascending.
+    pub fn ring(&self, i: usize) -> &[u32] {
+        &self.rings[self.ring_start[i]..self.ring_start[i + 1]]
+    }
+
+    /// The largest valence (at least 1).
+    pub fn valence(&self) -> usize {
+        (0..self.num_vertices).map(|i| self.ring(i).len()).max().unwrap_or(0).max(1)
+    }
+}
+
+/// Which Gaussians the op makes, on which mesh.
+#[derive(Clone, Debug)]
+pub struct BindConfig {
+    pub topology: Arc<Topology>,
+    pub face_gaussians: bool,
+    pub vertex_gaussians: bool,
+}
+
+impl BindConfig {
+    pub fn num_gaussians(&self) -> usize {
+        usize::from(self.face_gaussians) * self.topology.faces.len()
+            + usize::from(self.vertex_gaussians) * self.topology.num_vertices
+    }
+}
+
+/// Backends that run the fused binding.
+#[backend_extension(Flex, Autodiff)]
+pub trait BindingBackend: Backend {
+    /// `[G, PACKED]` Gaussians of posed vertices `[V, 3]`, face Gaussians first.
+    fn tavatar_bind_forward(vertices: FloatTensor<Self>, config: BindConfig) -> FloatTensor<Self>;
+
+    /// The `[V, 3]` gradient of the vertices given the gradient `grad` of the forward output.
+    fn tavatar_bind_backward(
+        vertices: FloatTensor<Self>,
+        grad: FloatTensor<Self>,
+        config: BindConfig,
+    ) -> FloatTensor<Self>;
+}
+
+/// Whether [`bind`] runs on `device` (Flex, with or without autodiff).
+pub fn supported(device: &Device) -> bool {
+    device.clone().inner() == Device::flex()
+}
+
+/// Tavatar's face and vertex Gaussians of posed `f32` vertices `[V, 3]` on a [`supported`]
+/// device, differentiable with respect to the vertices.
+pub fn bind(vertices: Tensor<2>, config: &BindConfig) -> GaussianGeometry {
+    let g = config.num_gaussians();
+    let packed = Tensor::<2>::from_dispatch(<Dispatch as BindingBackend>::tavatar_bind_forward(
+        vertices.into_dispatch(),
+        config.clone(),
+    ));
+    GaussianGeometry {
+        means: packed.clone().narrow(1, 0, 3),
+        frames: packed.clone().narrow(1, 3, 9).reshape([g, 3, 3]),
+        scales: packed.clone().narrow(1, 12, 3),
+        normals: packed.narrow(1, 15, 3),
+    }
+}
