@@ -66,8 +66,9 @@ impl<T: Real> Replay<T> {
     }
 }
 
-/// Replays tile `rect` and adds the screen-space gradients of each Gaussian that reached a pixel
-/// (`SCREEN_GRADS + C` values) into row `rank` of `acc`.
+/// Replays tile `rect` and writes the screen-space gradients of each Gaussian that reached a pixel
+/// (`SCREEN_GRADS + C` values) into row `k` of `rows` for the list's `k`-th entry (rows of
+/// Gaussians that reached none are left as they are).
 pub(crate) fn composite_tile_vjp<T: Real>(
     rect: TileRect,
     list: &[u32],
@@ -75,7 +76,7 @@ pub(crate) fn composite_tile_vjp<T: Real>(
     rule: &Rule<T>,
     px: &TileGrads<T>,
     st: &mut Replay<T>,
-    acc: &mut [T],
+    rows: &mut [T],
 ) {
     let channels = packed.stride - field::COLOR;
     st.t.fill(T::ONE);
@@ -96,7 +97,6 @@ pub(crate) fn composite_tile_vjp<T: Real>(
     for (k, &gid) in list[..end].iter().enumerate() {
         if let Some(&ahead) = list[..end].get(k + PREFETCH_AHEAD) {
             prefetch(&packed.rows, ahead as usize * packed.stride);
-            prefetch(acc, ahead as usize * stride);
         }
         let g = packed.row(gid);
         let (o, z) = (g[field::OPACITY], g[field::DEPTH]);
@@ -167,9 +167,8 @@ pub(crate) fn composite_tile_vjp<T: Real>(
             }
         }
         if touched {
-            let row = &mut acc[gid as usize * stride..(gid as usize + 1) * stride];
-            for (s, lane) in row.iter_mut().zip(&st.lanes) {
-                *s += lane.iter().copied().sum();
+            for (s, lane) in rows[k * stride..(k + 1) * stride].iter_mut().zip(&st.lanes) {
+                *s = lane.iter().copied().sum();
             }
         }
     }

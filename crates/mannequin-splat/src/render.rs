@@ -2,8 +2,6 @@
 //! replays it. Tiles run in parallel (rayon); each worker reuses its scratch, so there is no
 //! allocation per pixel or per tile.
 
-use std::sync::Mutex;
-
 use rayon::prelude::*;
 
 use crate::camera::{Camera, CameraParams};
@@ -335,14 +333,20 @@ pub(crate) fn backward_checked<T: Real>(
     let tiles = &prep.tiles;
     let stride = SCREEN_GRADS + ch;
     let rule = opts.rule::<T>();
-    // One dense accumulator per worker thread; a worker holds its own lock for a whole tile.
-    let workers = rayon::current_num_threads();
-    let visible = tiles.order.len();
-    let bufs: Vec<Mutex<Vec<T>>> =
-        (0..workers).map(|_| Mutex::new(vec![T::ZERO; visible * stride])).collect();
-    (0..tiles.tiles_x * tiles.tiles_y).into_par_iter().for_each_init(
+    // Each (tile, Gaussian) entry of the tile lists gets its own row, so tiles write disjoint
+    // memory in parallel; the rows are then summed per Gaussian in tile order, which makes the
+    // gradient bit-identical whichever thread ran which tile.
+    let mut entries = vec![T::ZERO; tiles.ids.len() * stride];
+    let mut rows: Vec<(usize, &mut [T])> = Vec::with_capacity(tiles.tiles_x * tiles.tiles_y);
+    let mut rest = entries.as_mut_slice();
+    for tile in 0..tiles.tiles_x * tiles.tiles_y {
+        let (head, tail) = rest.split_at_mut(tiles.list(tile).len() * stride);
+        rows.push((tile, head));
+        rest = tail;
+    }
+    rows.into_par_iter().for_each_init(
         || (TileGrads::new(ch), Replay::new(ch)),
-        |(px, replay), tile| {
+        |(px, replay), (tile, rows)| {
             let list = tiles.list(tile);
             if list.is_empty() {
                 return;
@@ -364,31 +368,47 @@ pub(crate) fn backward_checked<T: Real>(
                     }
                 }
             }
-            let slot = rayon::current_thread_index().unwrap_or(0) % workers;
-            let mut buf = bufs[slot].lock().unwrap_or_else(|e| e.into_inner());
-            composite_tile_vjp(rect, list, &prep.packed, &rule, px, replay, &mut buf);
+            composite_tile_vjp(rect, list, &prep.packed, &rule, px, replay, rows);
         },
     );
-    let bufs: Vec<Vec<T>> =
-        bufs.into_iter().map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
-    let parts: Vec<&[T]> = bufs.iter().map(Vec::as_slice).collect();
-    Ok(screen_vjp(g, camera, opts.dilation, &tiles.order, &parts, ch))
+    Ok(screen_vjp(g, camera, opts.dilation, tiles, &entries, ch))
 }
 
-/// Chains screen-space gradients back to every Gaussian's parameters. `parts` hold, by depth
-/// rank (`order[rank]` is the Gaussian), `SCREEN_GRADS + channels` sums each; they are added up.
+/// Each rank's entries in the tile lists, in tile order: entry indices grouped by rank
+/// (`entries[start[r]..start[r + 1]]`), by a counting sort.
+fn entries_by_rank(ids: &[u32], ranks: usize) -> (Vec<usize>, Vec<u32>) {
+    let mut start = vec![0usize; ranks + 1];
+    for &r in ids {
+        start[r as usize + 1] += 1;
+    }
+    for r in 0..ranks {
+        start[r + 1] += start[r];
+    }
+    let mut next = start.clone();
+    let mut entries = vec![0u32; ids.len()];
+    for (e, &r) in ids.iter().enumerate() {
+        entries[next[r as usize]] = e as u32;
+        next[r as usize] += 1;
+    }
+    (start, entries)
+}
+
+/// Chains screen-space gradients back to every Gaussian's parameters. `rows` hold
+/// `SCREEN_GRADS + channels` values per entry of the tile lists; each Gaussian sums its own
+/// entries in tile order.
 pub(crate) fn screen_vjp<T: Real>(
     g: &Gaussians<T>,
     camera: &Camera,
     dilation: f64,
-    order: &[u32],
-    parts: &[&[T]],
+    tiles: &Tiles,
+    rows: &[T],
     channels: usize,
 ) -> GaussianGrads<T> {
     let n = g.len();
     let stride = SCREEN_GRADS + channels;
+    let (start, by_rank) = entries_by_rank(&tiles.ids, tiles.order.len());
     let mut rank = vec![u32::MAX; n];
-    for (r, &i) in order.iter().enumerate() {
+    for (r, &i) in tiles.order.iter().enumerate() {
         rank[i as usize] = r as u32;
     }
     let (cam, dil) = (CameraParams::new(camera), T::from_f64(dilation));
@@ -410,10 +430,9 @@ pub(crate) fn screen_vjp<T: Real>(
                     return;
                 }
                 sum.fill(T::ZERO);
-                for b in parts {
-                    for (acc, v) in sum.iter_mut().zip(&b[at * stride..(at + 1) * stride]) {
-                        *acc += *v;
-                    }
+                for &e in &by_rank[start[at]..start[at + 1]] {
+                    let row = &rows[e as usize * stride..(e as usize + 1) * stride];
+                    sum.iter_mut().zip(row).for_each(|(s, &v)| *s += v);
                 }
                 // Gaussians that reached no pixel have zero gradient.
                 if sum.iter().all(|&v| v == T::ZERO) {

@@ -226,3 +226,31 @@ fn f32_gradients_agree_with_f64() {
         }
     }
 }
+
+/// Gradients are summed per Gaussian in tile order, not per worker thread, so the backward pass
+/// gives bit-identical results on one thread and on several (in f32, where a different order of
+/// additions would show).
+#[test]
+fn backward_is_bit_identical_whatever_the_thread_count() {
+    let scene = Scene::random(3000, 21, 1, 0).cast::<f32>();
+    let cam = camera(160, 120);
+    let opts = RenderOptions { background: vec![1.0; 3], ..RenderOptions::default() };
+    let g = scene.gaussians(RotForm::Matrix, ColorForm::Sh(1));
+    let mut rng = common::Rng::new(4);
+    let d_image: Vec<f32> = (0..3 * 160 * 120).map(|_| rng.uniform(-1.0, 1.0) as f32).collect();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let out = render(&g, &cam, &opts).unwrap();
+            let grads = OutputGrads { image: Some(&d_image), alpha: None, depth: None };
+            let d = backward(&g, &cam, &opts, &out, &grads).unwrap();
+            [d.means, d.rotations, d.scales, d.opacities, d.colors]
+                .map(|v| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>())
+        })
+    };
+    let one = run(1);
+    assert!(one[0].iter().any(|&b| b != 0), "some mean gradient is non-zero");
+    for threads in [2, 3, 8] {
+        assert!(run(threads) == one, "{threads} threads differ from one");
+    }
+}
