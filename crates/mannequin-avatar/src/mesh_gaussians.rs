@@ -54,7 +54,6 @@ impl GaussianGeometry {
 /// host for the fused binding.
 #[derive(Clone, Debug)]
 pub struct MeshIndex {
-    pub num_vertices: usize,
     pub corners: [Tensor<1, Int>; 3],
     /// [V · valence] neighbour indices, row-major; padding repeats the vertex itself.
     pub ring: Tensor<1, Int>,
@@ -83,7 +82,6 @@ impl MeshIndex {
             }
         }
         Self {
-            num_vertices,
             corners: [corner(0), corner(1), corner(2)],
             ring: Tensor::from_data(TensorData::new(ring, [num_vertices * valence]), device),
             ring_pad: Tensor::from_data(TensorData::new(pad, [num_vertices, valence]), device),
@@ -163,7 +161,7 @@ pub fn face_gaussians(faces: &Faces) -> GaussianGeometry {
 /// cross products (each 2 A_f n_f), normalised.
 pub fn vertex_normals(faces: &Faces, index: &MeshIndex) -> Tensor<2> {
     let cross = &faces.cross;
-    let mut sum = Tensor::zeros([index.num_vertices, 3], (&cross.device(), cross.dtype()));
+    let mut sum = Tensor::zeros([index.topology.num_vertices, 3], (&cross.device(), cross.dtype()));
     for corner in &index.corners {
         sum = sum.select_assign(0, corner.clone(), cross.clone(), IndexingUpdateOp::Add);
     }
@@ -175,14 +173,14 @@ pub fn vertex_gaussians(vertices: &Tensor<2>, faces: &Faces, index: &MeshIndex) 
     let n = vertex_normals(faces, index);
     // Eq. 10: the reference axis is the coordinate axis least aligned with the normal; the
     // choice is piecewise constant, so it carries no gradient.
-    let axis = n.clone().detach().abs().argmin(1).reshape([index.num_vertices]);
+    let axis = n.clone().detach().abs().argmin(1).reshape([index.topology.num_vertices]);
     let r: Tensor<2> = axis.one_hot::<2>(3).float().cast(n.dtype());
     let t1 = normalise(r.cross(n.clone(), 1));
     let t2 = n.clone().cross(t1.clone(), 1);
     // Eq. 11: γ times the shortest one-ring edge. The nearest neighbour is found on detached
     // values (padding lifted out of the min), then that one edge is measured again with a plain
     // gather, so the gradient reaches exactly the two vertices of the shortest edge.
-    let v = index.num_vertices;
+    let v = index.topology.num_vertices;
     let neighbours = vertices.clone().detach().select(0, index.ring.clone()).reshape([v, index.valence, 3]);
     let offsets = neighbours - vertices.clone().detach().unsqueeze_dim::<3>(1);
     let lengths = offsets.square().sum_dim(2).reshape([v, index.valence]);

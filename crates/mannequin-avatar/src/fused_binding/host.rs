@@ -193,17 +193,10 @@ impl Vertex {
         // Eq. 11: the shortest one-ring edge (first of equals, the vertex itself when isolated).
         let squared = |j: u32| {
             let d = sub(point(v, j), position);
-            d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            dot(d, d)
         };
-        let ring = topology.ring(i);
-        let nearest = ring.iter().copied().fold(None, |best: Option<(u32, f32)>, j| {
-            let d = squared(j);
-            match best {
-                Some((_, b)) if b <= d => best,
-                _ => Some((j, d)),
-            }
-        });
-        let nearest = nearest.map_or(i as u32, |(j, _)| j);
+        let ring = topology.ring(i).iter().copied();
+        let nearest = ring.min_by(|&a, &b| squared(a).total_cmp(&squared(b))).unwrap_or(i as u32);
         let edge = sub(point(v, nearest), position);
         Self { position, sum, sum_norm, axis, u, u_norm: norm(u), nearest, edge, edge_length: norm(edge) }
     }

@@ -14,6 +14,7 @@ use std::sync::Arc;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
 use burn::tensor::{Device, Tensor};
+use mannequin_mesh::adjacency::one_rings;
 
 use crate::mesh_gaussians::GaussianGeometry;
 
@@ -33,20 +34,13 @@ pub struct Topology {
 impl Topology {
     /// Faces must already be validated against `num_vertices`.
     pub fn new(num_vertices: usize, faces: &[[u32; 3]]) -> Self {
-        let mut rings: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
-        for f in faces {
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                rings[a as usize].push(b);
-                rings[b as usize].push(a);
-            }
-        }
-        let mut ring_start = vec![0];
-        for r in &mut rings {
-            r.sort_unstable();
-            r.dedup();
-            ring_start.push(ring_start.last().copied().unwrap_or(0) + r.len());
-        }
+        let rings = one_rings(num_vertices, faces);
+        let ring_start = std::iter::once(0)
+            .chain(rings.iter().scan(0, |end, r| {
+                *end += r.len();
+                Some(*end)
+            }))
+            .collect();
         Self { num_vertices, faces: faces.to_vec(), ring_start, rings: rings.concat() }
     }
 
