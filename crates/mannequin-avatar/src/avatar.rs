@@ -14,9 +14,11 @@ use crate::config::{AvatarConfig, Method};
 use crate::error::AvatarError;
 use crate::field::Field;
 use crate::fused_binding::{self, BindConfig};
+use crate::host_ops;
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
 use crate::params::{Param, tensor_from};
+use crate::sh_colour::{ColourConfig, colour_convention, sh_colour, sh_colour_tensors};
 use mannequin_data::rng::SplitMix64;
 
 /// Background of the colour channels: white, as the peers train and evaluate.
@@ -274,7 +276,7 @@ impl Avatar {
     pub fn bind(&self, vertices: &Tensor<2>) -> GaussianGeometry {
         match self.config.method {
             Method::Tavatar => {
-                let mut g = if fused_binding::supported(&self.device) {
+                let mut g = if host_ops::supported(&self.device) {
                     let config = BindConfig {
                         topology: self.index.topology.clone(),
                         face_gaussians: self.config.face_gaussians,
@@ -331,27 +333,23 @@ impl Avatar {
 
     /// Per-Gaussian RGB [G, 3] seen from `eye` (view-dependent through the SH).
     pub fn colours(&self, gaussians: &GaussianGeometry, eye: [f64; 3]) -> Result<Tensor<2>, AvatarError> {
-        let rgb = match self.config.method {
+        match self.config.method {
             Method::Tavatar => {
                 let coeffs = self.sh_coefficients().expect("Tavatar has SH");
-                let g = gaussians.len();
-                let k = sh::basis_len(self.config.sh_degree);
-                let eye = Tensor::<2>::from_data(
-                    burn::tensor::TensorData::new(eye.map(|x| x as f32).to_vec(), [1, 3]),
-                    &self.device,
-                );
-                let d = gaussians.means.clone() - eye;
-                let d = d.clone() / (d.square().sum_dim(1) + 1e-20).sqrt();
-                let basis = sh::basis_tensor(self.config.sh_degree, d)?; // [G, k]
-                let rgb = basis.unsqueeze_dim::<3>(2) * coeffs.reshape([g, k, 3]);
-                rgb.sum_dim(1).reshape([g, 3])
+                let config = ColourConfig { eye: eye.map(|x| x as f32), degree: self.config.sh_degree };
+                let means = gaussians.means.clone();
+                if host_ops::supported(&self.device) {
+                    Ok(sh_colour(means, coeffs, &config))
+                } else {
+                    Ok(sh_colour_tensors(means, coeffs, &config)?)
+                }
             }
             Method::Ihuman => {
-                self.colour_field.as_ref().expect("iHuman has a colour field").forward(&self.params)?
+                let rgb =
+                    self.colour_field.as_ref().expect("iHuman has a colour field").forward(&self.params)?;
+                Ok(colour_convention(rgb))
             }
-        };
-        // 3DGS's colour convention: SH value + 0.5, clamped at zero.
-        Ok((rgb + 0.5).clamp_min(0.0))
+        }
     }
 
     /// Renders colour over white and camera-space normals over zero in one pass of six channels.

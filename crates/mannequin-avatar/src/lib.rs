@@ -14,12 +14,14 @@ pub mod export;
 pub mod field;
 pub mod fused_binding;
 pub mod hash_grid;
+pub mod host_ops;
 pub mod ihuman;
 pub mod losses;
 pub mod mesh_gaussians;
 pub mod mlp;
 pub mod params;
 pub mod predict;
+pub mod sh_colour;
 pub mod trainer;
 pub mod views;
 

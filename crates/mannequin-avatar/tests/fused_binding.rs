@@ -3,7 +3,8 @@
 //! jittered so that no face or edge is special, with every ablation's set of Gaussians.
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
-use mannequin_avatar::fused_binding::{BindConfig, bind, supported};
+use mannequin_avatar::fused_binding::{BindConfig, bind};
+use mannequin_avatar::host_ops::supported;
 use mannequin_avatar::mesh_gaussians::{
     Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians,
 };

@@ -1,9 +1,7 @@
 //! Tavatar's binding (Eqs. 5–11) as one differentiable op with a hand-written backward, on Flex
 //! (CPU). Composed from tensor ops ([`crate::mesh_gaussians`]) the binding costs ~100 small
 //! allocating ops forward and as many backward, a fifth of a CPU training step; here it is one
-//! pass over faces and one over vertices each way. Other backends keep the tensor composition,
-//! which a GPU runs well: [`supported`] says which applies, and the tests hold the two to the
-//! same values and gradients.
+//! pass over faces and one over vertices each way ([`crate::host_ops`] says where it runs).
 
 mod autodiff;
 mod flex;
@@ -13,7 +11,7 @@ use std::sync::Arc;
 
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
-use burn::tensor::{Device, Tensor};
+use burn::tensor::Tensor;
 use mannequin_mesh::adjacency::one_rings;
 
 use crate::mesh_gaussians::GaussianGeometry;
@@ -84,13 +82,8 @@ pub trait BindingBackend: Backend {
     ) -> FloatTensor<Self>;
 }
 
-/// Whether [`bind`] runs on `device` (Flex, with or without autodiff).
-pub fn supported(device: &Device) -> bool {
-    device.clone().inner() == Device::flex()
-}
-
-/// Tavatar's face and vertex Gaussians of posed `f32` vertices `[V, 3]` on a [`supported`]
-/// device, differentiable with respect to the vertices.
+/// Tavatar's face and vertex Gaussians of posed `f32` vertices `[V, 3]` on a
+/// [`crate::host_ops::supported`] device, differentiable with respect to the vertices.
 pub fn bind(vertices: Tensor<2>, config: &BindConfig) -> GaussianGeometry {
     let g = config.num_gaussians();
     let packed = Tensor::<2>::from_dispatch(<Dispatch as BindingBackend>::tavatar_bind_forward(

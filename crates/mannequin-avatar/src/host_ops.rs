@@ -1,0 +1,11 @@
+//! Where the avatar's fused host ops run. The binding, the SH colour and the mesh regularisers
+//! each have one op with a hand-written backward for Flex (CPU), where composing them from
+//! small tensor ops costs most of a training step; other backends keep the tensor compositions,
+//! which a GPU runs well, and the tests hold the two to the same values and gradients.
+
+use burn::tensor::Device;
+
+/// Whether `device` runs the fused host ops (Flex, with or without autodiff).
+pub fn supported(device: &Device) -> bool {
+    device.clone().inner() == Device::flex()
+}
