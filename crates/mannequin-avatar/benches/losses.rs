@@ -5,8 +5,9 @@
 //!   `conv2d` with the direct 11×11 window (the baseline), `conv2d` as a 1×11 and an 11×1 pass,
 //!   and the separable blur op;
 //! - the blur alone on 540×540×6, the op against `conv2d` as a 1×11 and an 11×1 pass;
-//! - the mesh regularisers on the default body (13,380 vertices, 26,756 faces), against the
-//!   trainer's per-iteration budget of 150 ms.
+//! - the mesh regularisers on the default body (13,380 vertices, 26,756 faces): the fused host
+//!   op against the tensor composition it replaces on Flex, and against the trainer's
+//!   per-iteration budget of 150 ms.
 //!
 //! `cargo bench -p mannequin-avatar --bench losses` (add `-- --quick` for fewer repetitions).
 //! Times are medians, with the fastest run in brackets (the CPU may be shared).
@@ -132,21 +133,22 @@ fn mesh_section(reps: usize, device: &Device) {
         topology.num_vertices(),
         topology.num_faces()
     );
-    let report = |name: &str, loss: &dyn Fn(Tensor<2>) -> Tensor<1>| {
-        let (median, min) = median_and_min_ms(reps, || forward_backward(&vertices, |[v]| loss(v)));
+    type Loss<'a> = &'a dyn Fn(Tensor<2>) -> Tensor<1>;
+    let report = |name: &str, fused: Loss, tensors: Loss| {
+        let (median, min) = median_and_min_ms(reps, || forward_backward(&vertices, |[v]| fused(v)));
+        let (base, _) = median_and_min_ms(reps, || forward_backward(&vertices, |[v]| tensors(v)));
         println!(
-            "    {name:<36}{median:8.2} ms ({min:6.2})   {:5.1}% of the {BUDGET_MS} ms budget",
+            "    {name:<20} fused {median:6.2} ms ({min:6.2}), tensor ops {base:6.2} ms: {:4.1}× faster; {:4.1}% of the {BUDGET_MS} ms budget",
+            base / median,
             100.0 * median / BUDGET_MS
         );
     };
-    report("Laplacian", &|v| topology.laplacian(v).unwrap());
-    report("normal consistency", &|v| topology.normal_consistency(v).unwrap());
-    report("equilateral", &|v| topology.equilateral(v).unwrap());
-    report("all three, summed", &|v| {
-        topology.laplacian(v.clone()).unwrap()
-            + topology.normal_consistency(v.clone()).unwrap()
-            + topology.equilateral(v).unwrap()
+    let t = &topology;
+    report("Laplacian", &|v| t.laplacian(v).unwrap(), &|v| t.laplacian_tensors(v).unwrap());
+    report("normal consistency", &|v| t.normal_consistency(v).unwrap(), &|v| {
+        t.normal_consistency_tensors(v).unwrap()
     });
+    report("equilateral", &|v| t.equilateral(v).unwrap(), &|v| t.equilateral_tensors(v).unwrap());
 }
 
 fn main() {

@@ -13,8 +13,10 @@
 //! dimensionless angular term.
 
 use burn::tensor::Tensor;
+use glam::DVec3;
 
-use super::rows::{dot, length};
+use super::mesh_loss::{HostMesh, MeshTerm, add, sum_over_elements, vertex};
+use super::rows::{EPS, dot, length};
 use super::topology::MeshTopology;
 use crate::AvatarError;
 
@@ -24,6 +26,11 @@ const COS_60: f64 = 0.5;
 impl MeshTopology {
     /// `mean_f [Var(‖e₁‖, ‖e₂‖, ‖e₃‖) + Σ_φ (cos φ − ½)²]` over faces, as `[1]`.
     pub fn equilateral(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
+        self.fused_or(MeshTerm::Equilateral, vertices, |v| self.equilateral_tensors(v))
+    }
+
+    /// [`Self::equilateral`] composed from tensor ops.
+    pub fn equilateral_tensors(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
         self.check(&vertices)?;
         let [v0, v1, v2] = self.face_corners(&vertices);
         // Edges around the face; the angle at a corner lies between the edge in and the edge out.
@@ -46,4 +53,45 @@ impl MeshTopology {
         }
         Ok(loss.mean())
     }
+}
+
+/// The loss on the host. Gradients are gathered per edge: `g_l` for each length and `g_E` for
+/// each edge vector directly (through the dot products of the cosines), then `∂l/∂E = E/l`.
+/// The variance's mean drops out of its gradient (`Σ (l − m) = 0`).
+pub(super) fn equilateral_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+    let faces = &mesh.topology.faces;
+    let weight = 1.0 / faces.len() as f64;
+    let total = sum_over_elements(faces.len(), mesh.topology.num_vertices, grad, |f, grad| {
+        let corners = faces[f];
+        let p = corners.map(|i| vertex(v, i));
+        let edges = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
+        // Lengths floored as in the tensor form, where the floor has no gradient.
+        let squared = edges.map(|e| e.length_squared());
+        let lengths = squared.map(|s| if s > EPS * EPS { s.sqrt() } else { EPS });
+        let mean = lengths.iter().sum::<f64>() / 3.0;
+        let mut loss = lengths.iter().map(|l| (l - mean) * (l - mean)).sum::<f64>() / 3.0;
+        let (mut g_l, mut g_e) = (lengths.map(|l| weight * 2.0 / 3.0 * (l - mean)), [DVec3::ZERO; 3]);
+        for k in 0..3 {
+            let (into, out) = ((k + 2) % 3, k);
+            let (li, lo) = (lengths[into], lengths[out]);
+            let cos = -edges[into].dot(edges[out]) / (li * lo);
+            loss += (cos - COS_60) * (cos - COS_60);
+            let gamma = weight * 2.0 * (cos - COS_60);
+            g_e[into] -= gamma / (li * lo) * edges[out];
+            g_e[out] -= gamma / (li * lo) * edges[into];
+            g_l[into] -= gamma * cos / li;
+            g_l[out] -= gamma * cos / lo;
+        }
+        if let Some(grad) = grad {
+            for k in 0..3 {
+                let along = if squared[k] > EPS * EPS { edges[k] / lengths[k] } else { DVec3::ZERO };
+                let d = g_e[k] + g_l[k] * along;
+                // Edge k runs from corner k to corner k + 1.
+                add(grad, corners[(k + 1) % 3], d);
+                add(grad, corners[k], -d);
+            }
+        }
+        loss
+    });
+    total * weight
 }

@@ -3,7 +3,10 @@
 //! offset field `ΔV` of Eq. 4 alike.
 
 use burn::tensor::{IndexingUpdateOp, Tensor};
+use glam::DVec3;
+use rayon::prelude::*;
 
+use super::mesh_loss::{HostMesh, MeshTerm, vertex};
 use super::topology::MeshTopology;
 use crate::AvatarError;
 
@@ -24,7 +27,43 @@ impl MeshTopology {
     /// `mean_i ‖δ_i‖²` over the vertices that have neighbours, as `[1]`. The squared norm (not
     /// PyTorch3D's plain norm) keeps the loss smooth where δ = 0.
     pub fn laplacian(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
+        self.fused_or(MeshTerm::Laplacian, vertices, |v| self.laplacian_tensors(v))
+    }
+
+    /// [`Self::laplacian`] composed from tensor ops.
+    pub fn laplacian_tensors(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
         let delta = self.laplacian_vectors(vertices)?;
         Ok((delta.clone() * delta).sum() / self.num_connected as f64)
     }
+}
+
+/// δ_i of every vertex, from the one-rings.
+fn deltas(mesh: &HostMesh, v: &[f64]) -> Vec<DVec3> {
+    let t = &mesh.topology;
+    (0..t.num_vertices as u32)
+        .into_par_iter()
+        .map(|i| {
+            let ring = t.ring(i as usize);
+            if ring.is_empty() {
+                return DVec3::ZERO;
+            }
+            vertex(v, i) - ring.iter().map(|&j| vertex(v, j)).sum::<DVec3>() / ring.len() as f64
+        })
+        .collect()
+}
+
+/// The loss on the host, with `∂L/∂v_k = (2/N)(δ_k − Σ_{i∈N(k)} δ_i/|N(i)|)` (rings are
+/// symmetric, so each vertex gathers from its own ring).
+pub(super) fn laplacian_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+    let delta = deltas(mesh, v);
+    let scale = 1.0 / mesh.num_connected as f64;
+    if let Some(grad) = grad {
+        let t = &mesh.topology;
+        grad.par_chunks_mut(3).enumerate().for_each(|(k, g)| {
+            let pulled: DVec3 =
+                t.ring(k).iter().map(|&i| delta[i as usize] / t.ring(i as usize).len() as f64).sum();
+            g.copy_from_slice(&(2.0 * scale * (delta[k] - pulled)).to_array());
+        });
+    }
+    delta.iter().map(|d| d.length_squared()).sum::<f64>() * scale
 }

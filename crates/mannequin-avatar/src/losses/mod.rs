@@ -5,6 +5,7 @@
 pub mod blur;
 mod equilateral;
 mod laplacian;
+pub mod mesh_loss;
 mod normal_consistency;
 mod photometric;
 mod rows;

@@ -10,7 +10,8 @@
 
 use burn::tensor::Tensor;
 
-use super::rows::{dot, length};
+use super::mesh_loss::{HostMesh, MeshTerm, add, sum_over_elements, vertex};
+use super::rows::{EPS, dot, length};
 use super::topology::MeshTopology;
 use crate::AvatarError;
 
@@ -18,6 +19,11 @@ impl MeshTopology {
     /// Mean over face pairs sharing an edge of `1 − cos(n₁, n₂)`, as `[1]`; 0 when no edge is
     /// shared.
     pub fn normal_consistency(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
+        self.fused_or(MeshTerm::NormalConsistency, vertices, |v| self.normal_consistency_tensors(v))
+    }
+
+    /// [`Self::normal_consistency`] composed from tensor ops.
+    pub fn normal_consistency_tensors(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
         self.check(&vertices)?;
         let Some(hinges) = &self.hinges else {
             return Ok(Tensor::zeros([1], (&vertices.device(), vertices.dtype())));
@@ -32,4 +38,42 @@ impl MeshTopology {
         let cos = n1_n2 / (length(n1_sq) * length(n2_sq));
         Ok(cos.neg().mean() + 1.0)
     }
+}
+
+/// The loss on the host. Here the normals are formed (`n₁ = e × u`, `n₂ = w × e`, in f64), and
+/// `∂cos/∂n₁ = n₂/(|n₁||n₂|) − cos·n₁/|n₁|²` (likewise for `n₂`) is taken back through the cross
+/// products: `∂(n₁·g)/∂e = u × g`, `∂(n₁·g)/∂u = g × e`, `∂(n₂·g)/∂w = e × g`, `∂(n₂·g)/∂e = g × w`.
+pub(super) fn normal_consistency_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+    let h = mesh.hinges.len();
+    if h == 0 {
+        if let Some(g) = grad {
+            g.fill(0.0);
+        }
+        return 0.0;
+    }
+    let weight = -1.0 / h as f64;
+    let cosines = sum_over_elements(h, mesh.topology.num_vertices, grad, |k, grad| {
+        let [a, b, c, d] = mesh.hinges[k];
+        let p = vertex(v, a);
+        let (e, u, w) = (vertex(v, b) - p, vertex(v, c) - p, vertex(v, d) - p);
+        let (n1, n2) = (e.cross(u), w.cross(e));
+        // Lengths floored as in the tensor form, where the floor has no gradient.
+        let floored = |n: glam::DVec3| {
+            let s = n.length_squared();
+            if s > EPS * EPS { (s.sqrt(), n / s) } else { (EPS, glam::DVec3::ZERO) }
+        };
+        let ((l1, dl1), (l2, dl2)) = (floored(n1), floored(n2));
+        let cos = n1.dot(n2) / (l1 * l2);
+        if let Some(grad) = grad {
+            let g1 = weight * (n2 / (l1 * l2) - cos * dl1);
+            let g2 = weight * (n1 / (l1 * l2) - cos * dl2);
+            let (de, du, dw) = (u.cross(g1) + g2.cross(w), g1.cross(e), e.cross(g2));
+            add(grad, a, -(de + du + dw));
+            add(grad, b, de);
+            add(grad, c, du);
+            add(grad, d, dw);
+        }
+        cos
+    });
+    1.0 + weight * cosines
 }

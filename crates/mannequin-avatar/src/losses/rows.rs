@@ -4,7 +4,7 @@ use burn::tensor::Tensor;
 
 /// Floor on a length (of an edge, or of a normal), so that degenerate faces give a finite
 /// gradient.
-const EPS: f64 = 1e-12;
+pub(super) const EPS: f64 = 1e-12;
 
 /// Row-wise dot product of `[N, 3]` tensors, `[N, 1]`.
 pub(super) fn dot(x: Tensor<2>, y: Tensor<2>) -> Tensor<2> {

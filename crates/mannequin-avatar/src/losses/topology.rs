@@ -1,9 +1,13 @@
 //! The fixed connectivity the mesh regularisers read, built once from the faces: the index
 //! tensors their gathers and scatters use, so each loss evaluation is a handful of tensor ops.
 
+use std::sync::Arc;
+
 use burn::tensor::{Device, Int, Tensor, TensorData};
 
+use super::mesh_loss::{HostMesh, MeshLoss, MeshTerm, mesh_loss};
 use crate::AvatarError;
+use crate::fused_binding::Topology;
 
 /// Edges, one-rings and face pairs of a triangle mesh, as index tensors on one device.
 #[derive(Debug, Clone)]
@@ -26,6 +30,8 @@ pub struct MeshTopology {
     pub(super) hinges: Option<[Tensor<1, Int>; 4]>,
     num_edges: usize,
     num_hinges: usize,
+    /// The same mesh for the fused host op.
+    host: Arc<HostMesh>,
 }
 
 fn indices(v: Vec<i64>, device: &Device) -> Tensor<1, Int> {
@@ -73,12 +79,17 @@ impl MeshTopology {
                 }
             }
         }
-        let num_connected = degree.iter().filter(|&&d| d > 0).count();
         let column = |f: fn(u32) -> f32| {
             let v: Vec<f32> = degree.iter().map(|&d| f(d)).collect();
             Tensor::from_data(TensorData::new(v, [num_vertices, 1]), device)
         };
         let (num_edges, num_hinges) = (from.len() / 2, hinge[0].len());
+        let num_connected = degree.iter().filter(|&&d| d > 0).count();
+        let host = Arc::new(HostMesh {
+            topology: Arc::new(Topology::new(num_vertices, faces)),
+            hinges: (0..num_hinges).map(|k| hinge.each_ref().map(|h| h[k] as u32)).collect(),
+            num_connected,
+        });
         Ok(Self {
             num_vertices,
             device: device.clone(),
@@ -91,6 +102,7 @@ impl MeshTopology {
             hinges: (num_hinges > 0).then(|| hinge.map(|h| indices(h, device))),
             num_edges,
             num_hinges,
+            host,
         })
     }
 
@@ -129,6 +141,20 @@ impl MeshTopology {
             )));
         }
         Ok(())
+    }
+
+    /// The term by the fused host op where the device runs it, else by `tensors`.
+    pub(super) fn fused_or(
+        &self,
+        term: MeshTerm,
+        vertices: Tensor<2>,
+        tensors: impl FnOnce(Tensor<2>) -> Result<Tensor<1>, AvatarError>,
+    ) -> Result<Tensor<1>, AvatarError> {
+        if !crate::host_ops::supported(&self.device) {
+            return tensors(vertices);
+        }
+        self.check(&vertices)?;
+        Ok(mesh_loss(vertices, MeshLoss { term, mesh: self.host.clone() }))
     }
 
     /// The three corners of every face, `[F, 3]` each.
