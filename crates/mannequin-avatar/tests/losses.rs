@@ -316,31 +316,41 @@ fn flat_grid(n: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 }
 
 #[test]
-fn equilateral_triangle_costs_nothing() {
-    // An equilateral triangle of side 2, tilted out of every coordinate plane.
+fn equilateral_triangle_costs_the_minimum_three_quarters() {
+    // An equilateral triangle of side 2, tilted out of every coordinate plane: no variance, and
+    // Σ (1 − cos 60°)² = 3 · ¼.
     let s3 = 3f64.sqrt();
     let tri = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, s3, 0.0]];
     let (c, s) = (0.6f64, 0.8f64);
     let rotated: Vec<[f64; 3]> =
         tri.iter().map(|p| [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2] + 1.0]).collect();
-    let loss = scalar(topology(3, &[[0, 1, 2]]).equilateral(vertices(&rotated)).unwrap());
-    assert!(loss.abs() < 1e-14, "{loss}");
+    let topo = topology(3, &[[0, 1, 2]]);
+    let loss = scalar(topo.equilateral(vertices(&rotated)).unwrap());
+    assert!((loss - 0.75).abs() < 1e-14, "{loss}");
+    // It is the minimum: moving any corner in any direction costs more.
+    let mut rng = SplitMix64::new(4);
+    for _ in 0..20 {
+        let mut moved = rotated.clone();
+        let (k, d) = (rng.below(3), rng.below(3));
+        moved[k][d] += rng.range(-0.05, 0.05);
+        assert!(scalar(topo.equilateral(vertices(&moved)).unwrap()) > loss);
+    }
 }
 
 #[test]
 fn right_triangle_three_four_five_costs_what_was_worked_out_by_hand() {
     // Sides 3, 4, 5: mean 4, population variance ((−1)² + 0² + 1²)/3 = 2/3.
     // Angles: 90° (cos 0) and the two acute ones with cos 4/5 and cos 3/5, so
-    // Σ (cos φ − ½)² = ¼ + (3/10)² + (1/10)² = 0.25 + 0.09 + 0.01 = 0.35.
-    // Total 2/3 + 0.35 = 61/60.
+    // Σ (1 − cos φ)² = 1 + (1/5)² + (2/5)² = 1 + 0.04 + 0.16 = 1.2.
+    // Total 2/3 + 6/5 = 28/15.
     let tri = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 3.0, 0.0]];
     let loss = scalar(topology(3, &[[0, 1, 2]]).equilateral(vertices(&tri)).unwrap());
-    assert!((loss - 61.0 / 60.0).abs() < 1e-14, "{loss}");
-    // Two faces average, not sum: add an equilateral face far away.
+    assert!((loss - 28.0 / 15.0).abs() < 1e-14, "{loss}");
+    // Two faces average, not sum: add an equilateral face (¾) far away.
     let s3 = 3f64.sqrt();
     let both = [tri.as_slice(), &[[10.0, 0.0, 0.0], [12.0, 0.0, 0.0], [11.0, s3, 0.0]]].concat();
     let loss = scalar(topology(6, &[[0, 1, 2], [3, 4, 5]]).equilateral(vertices(&both)).unwrap());
-    assert!((loss - 61.0 / 120.0).abs() < 1e-14, "{loss}");
+    assert!((loss - (28.0 / 15.0 + 0.75) / 2.0).abs() < 1e-14, "{loss}");
 }
 
 #[test]

@@ -2,10 +2,10 @@
 //! plus an angular term, so that triangles (whose inradius and edge lengths set the Gaussian
 //! scales, Eqs. 8 and 11) stay well shaped.
 //!
-//! Two readings of Eq. 14, both deliberate:
-//! - The angular term is written `Σ_φ (1 − cos φ)²`, which is zero at φ = 0, not at 60°; the text
-//!   says it "penalizes deviations from 60°". We implement that intent: `Σ_φ (cos φ − ½)²`,
-//!   zero exactly for an equilateral triangle.
+//! - The angular term is Eq. 14's `Σ_φ (1 − cos φ)²`. Each summand is smallest at φ = 0, but a
+//!   triangle's angles sum to 180°, and over triangles the sum is smallest (¾) exactly at the
+//!   equilateral one, so it penalises deviations from 60° as the text says: a right isosceles
+//!   triangle costs 1.17, a 120°–30°–30° one 2.29.
 //! - Eq. 14 sums over faces; we average, so that the weight λ_t = 0.01 does not grow with the
 //!   face count. `Var` is the population variance (divide by 3).
 //!
@@ -20,11 +20,8 @@ use super::rows::{EPS, dot, length};
 use super::topology::MeshTopology;
 use crate::AvatarError;
 
-/// `cos 60°`.
-const COS_60: f64 = 0.5;
-
 impl MeshTopology {
-    /// `mean_f [Var(‖e₁‖, ‖e₂‖, ‖e₃‖) + Σ_φ (cos φ − ½)²]` over faces, as `[1]`.
+    /// `mean_f [Var(‖e₁‖, ‖e₂‖, ‖e₃‖) + Σ_φ (1 − cos φ)²]` over faces, as `[1]`.
     pub fn equilateral(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
         self.fused_or(MeshTerm::Equilateral, vertices, |v| self.equilateral_tensors(v))
     }
@@ -48,7 +45,7 @@ impl MeshTopology {
             let (into, out) = ((k + 2) % 3, k);
             let cos = dot(edges[into].clone(), edges[out].clone()).neg()
                 / (lengths[into].clone() * lengths[out].clone());
-            let off = cos - COS_60;
+            let off = cos.neg() + 1.0;
             loss = loss + off.clone() * off;
         }
         Ok(loss.mean())
@@ -75,8 +72,8 @@ pub(super) fn equilateral_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f6
             let (into, out) = ((k + 2) % 3, k);
             let (li, lo) = (lengths[into], lengths[out]);
             let cos = -edges[into].dot(edges[out]) / (li * lo);
-            loss += (cos - COS_60) * (cos - COS_60);
-            let gamma = weight * 2.0 * (cos - COS_60);
+            loss += (1.0 - cos) * (1.0 - cos);
+            let gamma = -weight * 2.0 * (1.0 - cos);
             g_e[into] -= gamma / (li * lo) * edges[out];
             g_e[out] -= gamma / (li * lo) * edges[into];
             g_l[into] -= gamma * cos / li;
