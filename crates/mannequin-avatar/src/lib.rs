@@ -13,6 +13,7 @@ pub mod evaluation;
 pub mod export;
 pub mod field;
 pub mod fused_binding;
+pub mod fused_mlp;
 pub mod hash_grid;
 pub mod host_ops;
 pub mod ihuman;

@@ -3,6 +3,7 @@
 
 use burn::tensor::{Device, Tensor, activation::relu};
 
+use crate::fused_mlp;
 use crate::params::{Param, tensor_from};
 use mannequin_data::rng::SplitMix64;
 
@@ -13,6 +14,17 @@ pub struct Mlp {
 }
 
 impl Mlp {
+    /// Input width, then each layer's output width.
+    pub fn widths(&self, params: &[Param]) -> Vec<usize> {
+        let dims = |l: &(usize, usize)| params[l.0].value.dims();
+        self.layers
+            .first()
+            .map(|l| dims(l)[0])
+            .into_iter()
+            .chain(self.layers.iter().map(|l| dims(l)[1]))
+            .collect()
+    }
+
     /// Appends the layers' parameters to `params`: He-uniform weights from `rng`, zero biases,
     /// and a zero last layer so the network starts as the zero function (no offsets, grey).
     pub fn new(
@@ -47,6 +59,11 @@ impl Mlp {
     }
 
     pub fn forward(&self, params: &[Param], x: Tensor<2>) -> Tensor<2> {
+        if crate::host_ops::supported(&x.device()) && fused_mlp::supports(&self.widths(params)) {
+            let [w0, w1, w2] = [0, 1, 2].map(|l| params[self.layers[l].0].value.clone());
+            let [b0, b1, b2] = [0, 1, 2].map(|l| params[self.layers[l].1].value.clone());
+            return fused_mlp::mlp(x, [w0, w1, w2], [b0, b1, b2]);
+        }
         let mut h = x;
         for (l, &(w, b)) in self.layers.iter().enumerate() {
             h = h.matmul(params[w].value.clone()) + params[b].value.clone();

@@ -1,0 +1,76 @@
+//! The fused MLP op (f32) against the same network composed from Burn's ops in f64 and
+//! differentiated by Burn's autodiff: same outputs and same gradients of the inputs, weights and
+//! biases, for every width the op is compiled for, with inputs that switch ReLUs off.
+
+use burn::tensor::{DType, Device, Tensor, TensorData, activation::relu};
+use mannequin_avatar::fused_mlp::{WIDTHS, mlp, supports};
+use mannequin_data::rng::SplitMix64;
+
+fn host(t: Tensor<2>) -> Vec<f32> {
+    t.into_data().convert::<f32>().iter::<f32>().collect()
+}
+
+/// Every entry within `tol` of the reference, relative to the entry plus the reference's RMS.
+fn assert_close(what: &str, got: &[f32], want: &[f32], tol: f32) {
+    assert_eq!(got.len(), want.len(), "{what}: lengths");
+    let rms = (want.iter().map(|x| x * x).sum::<f32>() / want.len() as f32).sqrt();
+    assert!(rms > 0.0, "{what}: the reference is not all zero");
+    for (i, (a, b)) in got.iter().zip(want).enumerate() {
+        let e = (a - b).abs() / (b.abs() + rms);
+        assert!(e <= tol, "{what}: entry {i}: {a} vs {b} (relative {e:e}, rms {rms})");
+    }
+}
+
+#[test]
+fn fused_mlp_matches_the_composition_and_its_autodiff() {
+    assert!(supports(&[32, 64, 64, 3]) && !supports(&[32, 64, 32, 3]) && !supports(&[32, 64, 3]));
+    let device = Device::flex().autodiff();
+    let mut rng = SplitMix64::new(9);
+    // Not a multiple of the op's row chunks or blocks.
+    let n = 1237;
+    for [i, h, o] in WIDTHS {
+        let shapes = [[n, i], [i, h], [1, h], [h, h], [1, h], [h, o], [1, o]];
+        let values: Vec<Vec<f32>> = shapes
+            .iter()
+            .map(|&[r, c]| {
+                let bound = (3.0 / r as f64).sqrt();
+                (0..r * c).map(|_| rng.range(-bound, bound) as f32).collect()
+            })
+            .collect();
+        let inputs = |dtype: DType| -> Vec<Tensor<2>> {
+            values
+                .iter()
+                .zip(shapes)
+                .map(|(v, s)| {
+                    Tensor::<2>::from_data(TensorData::new(v.clone(), s), (&device, dtype)).require_grad()
+                })
+                .collect()
+        };
+        let run = |fused: bool| {
+            let t = inputs(if fused { DType::F32 } else { DType::F64 });
+            let out = if fused {
+                mlp(
+                    t[0].clone(),
+                    [t[1].clone(), t[3].clone(), t[5].clone()],
+                    [t[2].clone(), t[4].clone(), t[6].clone()],
+                )
+            } else {
+                let h1 = relu(t[0].clone().matmul(t[1].clone()) + t[2].clone());
+                let h2 = relu(h1.matmul(t[3].clone()) + t[4].clone());
+                h2.matmul(t[5].clone()) + t[6].clone()
+            };
+            let mut w = SplitMix64::new(2);
+            let weights: Vec<f32> = (0..n * o).map(|_| w.range(-1.0, 1.0) as f32).collect();
+            let weights = Tensor::<2>::from_data(TensorData::new(weights, [n, o]), (&device, out.dtype()));
+            let grads = (out.clone() * weights).sum().backward();
+            let mut all = vec![host(out)];
+            all.extend(t.iter().map(|t| host(t.grad(&grads).expect("every input gets a gradient"))));
+            all
+        };
+        let (got, want) = (run(true), run(false));
+        let names = ["outputs", "dx", "dw0", "db0", "dw1", "db1", "dw2", "db2"];
+        for ((name, a), b) in names.iter().zip(&got).zip(&want) {
+            assert_close(&format!("[{i}, {h}, {o}] {name}"), a, b, 1e-5);
+        }
+    }
+}
