@@ -1,5 +1,5 @@
-//! Where the avatar's fused host ops run. The binding, the SH colour and the mesh regularisers
-//! each have one op with a hand-written backward for Flex (CPU), where composing them from
+//! Where the avatar's fused host ops run. The binding, the SH colour, the MLP head and the mesh
+//! regularisers each have one op with a hand-written backward for Flex (CPU), where composing them from
 //! small tensor ops costs most of a training step; other backends keep the tensor compositions,
 //! which a GPU runs well, and the tests hold the two to the same values and gradients.
 
