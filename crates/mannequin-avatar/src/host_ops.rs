@@ -3,9 +3,15 @@
 //! small tensor ops costs most of a training step; other backends keep the tensor compositions,
 //! which a GPU runs well, and the tests hold the two to the same values and gradients.
 
+use burn::backend::flex::FlexTensor;
 use burn::tensor::Device;
 
 /// Whether `device` runs the fused host ops (Flex, with or without autodiff).
 pub fn supported(device: &Device) -> bool {
     device.clone().inner() == Device::flex()
+}
+
+/// `t` with a contiguous buffer (the host passes read tensors as plain slices).
+pub(crate) fn contiguous(t: FlexTensor) -> FlexTensor {
+    if t.is_contiguous() { t } else { t.to_contiguous() }
 }

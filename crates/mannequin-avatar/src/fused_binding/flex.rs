@@ -6,12 +6,9 @@ use burn::backend::tensor::FloatTensor;
 use burn::tensor::TensorData;
 
 use super::{BindConfig, BindingBackend, PACKED, host};
+use crate::host_ops::contiguous;
 
 const LAYOUT: &str = "binding tensors are f32 (`bind` takes the avatar's f32 vertices)";
-
-fn contiguous(t: FlexTensor) -> FlexTensor {
-    if t.is_contiguous() { t } else { t.to_contiguous() }
-}
 
 impl BindingBackend for Flex {
     fn tavatar_bind_forward(vertices: FloatTensor<Self>, config: BindConfig) -> FloatTensor<Self> {

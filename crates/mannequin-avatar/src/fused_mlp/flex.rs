@@ -7,12 +7,9 @@ use burn::tensor::TensorData;
 
 use super::host::{self, Weights};
 use super::{MlpBackend, WIDTHS};
+use crate::host_ops::contiguous;
 
 const LAYOUT: &str = "MLP tensors are f32 (the avatar's parameters and encodings)";
-
-fn contiguous(t: FlexTensor) -> FlexTensor {
-    if t.is_contiguous() { t } else { t.to_contiguous() }
-}
 
 fn tensor(values: Vec<f32>, shape: [usize; 2]) -> FlexTensor {
     FlexTensor::from_data(TensorData::new(values, shape))

@@ -13,6 +13,7 @@ use burn::tensor::{DType, TensorData};
 use rayon::prelude::*;
 
 use super::{CORNERS, HashGridBackend};
+use crate::host_ops::contiguous;
 
 /// (level, point) pairs per forward task.
 const PAIRS_PER_TASK: usize = 1024;
@@ -25,10 +26,6 @@ const LAYOUT: &str = "hash-grid tensors have the dtypes and shapes `encode` chec
 
 trait Real: Copy + Default + Send + Sync + Mul<Output = Self> + AddAssign {}
 impl<T: Copy + Default + Send + Sync + Mul<Output = T> + AddAssign> Real for T {}
-
-fn contiguous(t: FlexTensor) -> FlexTensor {
-    if t.is_contiguous() { t } else { t.to_contiguous() }
-}
 
 fn ints(t: &FlexTensor) -> &[i32] {
     t.as_slice::<i32>().expect(LAYOUT)

@@ -6,12 +6,9 @@ use burn::backend::tensor::FloatTensor;
 use burn::tensor::TensorData;
 
 use super::{ColourBackend, ColourConfig, host};
+use crate::host_ops::contiguous;
 
 const LAYOUT: &str = "colour tensors are f32 (the avatar's parameters and means)";
-
-fn contiguous(t: FlexTensor) -> FlexTensor {
-    if t.is_contiguous() { t } else { t.to_contiguous() }
-}
 
 impl ColourBackend for Flex {
     fn sh_colour_forward(

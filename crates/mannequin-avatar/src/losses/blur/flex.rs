@@ -8,6 +8,7 @@ use burn::tensor::{DType, FloatDType, TensorData};
 
 use super::BlurBackend;
 use super::host::{Planes, Sample, blur_rows};
+use crate::host_ops::contiguous;
 
 /// The blur of a contiguous `[n, h, w]` buffer with zero padding `p`.
 fn blur<T: Sample>(x: &[T], [n, h, w]: [usize; 3], p: usize) -> TensorData {
@@ -19,10 +20,6 @@ fn blur<T: Sample>(x: &[T], [n, h, w]: [usize; 3], p: usize) -> TensorData {
         |_, _, blurred, out| out.copy_from_slice(blurred),
     );
     TensorData::new(out, [n, s.out_h(), s.out_w()])
-}
-
-fn contiguous(t: FlexTensor) -> FlexTensor {
-    if t.is_contiguous() { t } else { t.to_contiguous() }
 }
 
 impl BlurBackend for Flex {
