@@ -5,6 +5,8 @@ use burn::backend::flex::FlexTensor;
 use burn::backend::tensor::FloatTensor;
 use burn::tensor::TensorData;
 
+use mannequin_splat::sh::basis_len;
+
 use super::{ColourBackend, ColourConfig, host};
 use crate::host_ops::contiguous;
 
@@ -32,7 +34,7 @@ impl ColourBackend for Flex {
         let (m, c) = (m.as_slice::<f32>().expect(LAYOUT), c.as_slice::<f32>().expect(LAYOUT));
         let (dm, dc) = host::backward(m, c, g.as_slice::<f32>().expect(LAYOUT), &config);
         let n = m.len() / 3;
-        let k3 = c.len() / n.max(1);
+        let k3 = 3 * basis_len(config.degree);
         (
             FlexTensor::from_data(TensorData::new(dm, [n, 3])),
             FlexTensor::from_data(TensorData::new(dc, [n, k3])),
