@@ -1,17 +1,14 @@
 //! Bad model and motion files give one-line errors that name the file and the field; never a panic.
 
 mod common;
+#[path = "common/scratch.rs"]
+mod scratch;
 
 use std::path::PathBuf;
 
 use mannequin_body::{Motion, load_npz, parse_model};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mq-body-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use scratch::Scratch;
 
 /// A valid small SMPL-format model as an editable list of arrays.
 fn model_arrays() -> Vec<(String, NpyArray)> {
@@ -36,7 +33,7 @@ fn one_line(msg: &str, file: &str, field: &str) {
 
 #[test]
 fn missing_key_names_file_and_key() {
-    let dir = temp_dir("missing");
+    let dir = Scratch::new("missing");
     let path = dir.join("no_weights.npz");
     let arrays: Vec<_> = model_arrays().into_iter().filter(|(k, _)| k != "weights").collect();
     write(&path, &arrays);
@@ -46,7 +43,7 @@ fn missing_key_names_file_and_key() {
 
 #[test]
 fn wrong_shape_names_field_and_expected_shape() {
-    let dir = temp_dir("shape");
+    let dir = Scratch::new("shape");
     let path = dir.join("bad_shape.npz");
     let mut arrays = model_arrays();
     for (k, a) in arrays.iter_mut() {
@@ -70,7 +67,7 @@ fn too_many_betas_requested() {
 
 #[test]
 fn truncated_npz_is_a_clean_error() {
-    let dir = temp_dir("trunc");
+    let dir = Scratch::new("trunc");
     let full = common::random_model::random_model_npz(24, 4, 6, 8);
     for cut in [0, 20, full.len() / 3, full.len() - 10] {
         let path = dir.join(format!("cut_{cut}.npz"));
@@ -92,7 +89,7 @@ fn amass(path: &PathBuf, width: usize, poses: Vec<f64>) {
 
 #[test]
 fn nan_in_a_pose_names_file_field_and_frame() {
-    let dir = temp_dir("nan");
+    let dir = Scratch::new("nan");
     let path = dir.join("nan_walk.npz");
     let mut poses = vec![0.1; 3 * 156];
     poses[156 + 40] = f64::NAN;
@@ -104,7 +101,7 @@ fn nan_in_a_pose_names_file_field_and_frame() {
 
 #[test]
 fn motion_with_unmappable_joint_count_is_rejected() {
-    let dir = temp_dir("joints");
+    let dir = Scratch::new("joints");
     let path = dir.join("odd.npz");
     amass(&path, 30, vec![0.0; 60]);
     let motion = Motion::read(&path).unwrap();
@@ -116,7 +113,7 @@ fn motion_with_unmappable_joint_count_is_rejected() {
 
 #[test]
 fn missing_frame_rate_is_named() {
-    let dir = temp_dir("fps");
+    let dir = Scratch::new("fps");
     let path = dir.join("nofps.npz");
     let mut w = NpzWriter::new();
     w.add("poses", NpyArray::f64(vec![1, 72], vec![0.0; 72]))

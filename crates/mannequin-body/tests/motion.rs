@@ -1,15 +1,12 @@
 //! Motion files: AMASS and PeopleSnapshot reading, layout mapping and resampling.
 
 mod common;
+#[path = "common/scratch.rs"]
+mod scratch;
 
 use mannequin_body::{Motion, parse_model};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
-
-fn temp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("mq-motion-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
+use scratch::Scratch;
 
 fn smpl() -> mannequin_body::BodyModel {
     let bytes = common::random_model::random_model_npz(24, 4, 6, 8);
@@ -18,7 +15,8 @@ fn smpl() -> mannequin_body::BodyModel {
 
 #[test]
 fn smplh_clip_maps_body_joints_and_rests_the_hands() {
-    let path = temp("smplh.npz");
+    let dir = Scratch::new("motion-smplh");
+    let path = dir.join("smplh.npz");
     let poses: Vec<f64> = (0..2 * 156).map(|i| i as f64 * 1e-3).collect();
     let mut w = NpzWriter::new();
     w.add("poses", NpyArray::f64(vec![2, 156], poses.clone()))
@@ -45,7 +43,8 @@ fn smplh_clip_maps_body_joints_and_rests_the_hands() {
 
 #[test]
 fn people_snapshot_poses_concatenate_orient_and_body() {
-    let path = temp("anim_nerf_train.npz");
+    let dir = Scratch::new("motion-anim_nerf_train");
+    let path = dir.join("anim_nerf_train.npz");
     let mut w = NpzWriter::new();
     w.add("betas", NpyArray::f32(vec![1, 10], vec![0.2; 10]))
         .add("global_orient", NpyArray::f32(vec![3, 3], (0..9).map(|i| i as f32).collect()))
@@ -84,7 +83,8 @@ fn resampling_halves_the_rate_and_slerps() {
 #[test]
 fn amass_write_read_round_trip() {
     let walk = Motion::walk_cycle(1.0, 30.0);
-    let path = temp("walk.npz");
+    let dir = Scratch::new("motion-walk");
+    let path = dir.join("walk.npz");
     walk.write_amass(&path).unwrap();
     let back = Motion::read(&path).unwrap();
     assert_eq!((back.num_frames(), back.joints, back.fps), (30, 24, 30.0));
