@@ -106,13 +106,14 @@ type AblationRow = Vec<(&'static str, f64, f64)>;
 fn main() {
     let iters: usize = arg("--iters", 2000);
     let seed: u64 = arg("--seed", 0);
-    let subjects: u64 = arg("--subjects", 1);
+    let subjects: u64 = arg("--subjects", 1).max(1);
     let ablations = std::env::args().any(|a| a == "--ablations");
     let dir = std::env::temp_dir().join(format!("mannequin-avatar-bench-{}", std::process::id()));
     let model = BodyModel::default_body();
     let mut table: Vec<(u64, AblationRow)> = Vec::new();
     for subject in seed..seed + subjects {
-        let (dir, data) = (dir.join(format!("seed-{subject}")), dir.join(format!("seed-{subject}/subject")));
+        let dir = dir.join(format!("seed-{subject}"));
+        let data = dir.join("subject");
         let options = SynthOptions { seed: subject, ..SynthOptions::default() };
         let summary = generate(&model, &data, &options, &|| {}).expect("synth");
         println!("subject: synth seed {subject} ({:?}), {iters} iterations", summary.subject.outfit);
