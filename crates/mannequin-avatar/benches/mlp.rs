@@ -4,8 +4,9 @@
 //!
 //! `cargo bench -p mannequin-avatar --bench mlp`
 
-use burn::tensor::{Device, Tensor, TensorData, activation::relu};
+use burn::tensor::{Device, Tensor, TensorData};
 use mannequin_avatar::fused_mlp::mlp;
+use mannequin_avatar::mlp::mlp_tensors;
 use mannequin_data::rng::SplitMix64;
 
 mod timing;
@@ -34,9 +35,7 @@ fn main() {
                 [t[2].clone(), t[4].clone(), t[6].clone()],
             )
         } else {
-            let h1 = relu(t[0].clone().matmul(t[1].clone()) + t[2].clone());
-            let h2 = relu(h1.matmul(t[3].clone()) + t[4].clone());
-            h2.matmul(t[5].clone()) + t[6].clone()
+            mlp_tensors(t[0].clone(), [1, 3, 5].into_iter().map(|l| (t[l].clone(), t[l + 1].clone())))
         }
     };
     let forward = |fused: bool| drop(network(fused, &inputs()).into_data());

@@ -64,13 +64,16 @@ impl Mlp {
             let [b0, b1, b2] = [0, 1, 2].map(|l| params[self.layers[l].1].value.clone());
             return fused_mlp::mlp(x, [w0, w1, w2], [b0, b1, b2]);
         }
-        let mut h = x;
-        for (l, &(w, b)) in self.layers.iter().enumerate() {
-            h = h.matmul(params[w].value.clone()) + params[b].value.clone();
-            if l + 1 < self.layers.len() {
-                h = relu(h);
-            }
-        }
-        h
+        mlp_tensors(x, self.layers.iter().map(|&(w, b)| (params[w].value.clone(), params[b].value.clone())))
     }
+}
+
+/// The network composed from Burn's ops, any depth: ReLU after every layer but the last. It runs
+/// where the fused op does not, and is the reference the fused op is held to.
+pub fn mlp_tensors(x: Tensor<2>, layers: impl ExactSizeIterator<Item = (Tensor<2>, Tensor<2>)>) -> Tensor<2> {
+    let depth = layers.len();
+    layers.enumerate().fold(x, |h, (l, (w, b))| {
+        let h = h.matmul(w) + b;
+        if l + 1 < depth { relu(h) } else { h }
+    })
 }

@@ -2,8 +2,9 @@
 //! differentiated by Burn's autodiff: same outputs and same gradients of the inputs, weights and
 //! biases, for every width the op is compiled for, with inputs that switch ReLUs off.
 
-use burn::tensor::{DType, Device, Tensor, TensorData, activation::relu};
+use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::fused_mlp::{WIDTHS, mlp, supports};
+use mannequin_avatar::mlp::mlp_tensors;
 use mannequin_data::rng::SplitMix64;
 
 fn host(t: Tensor<2>) -> Vec<f32> {
@@ -55,9 +56,7 @@ fn fused_mlp_matches_the_composition_and_its_autodiff() {
                     [t[2].clone(), t[4].clone(), t[6].clone()],
                 )
             } else {
-                let h1 = relu(t[0].clone().matmul(t[1].clone()) + t[2].clone());
-                let h2 = relu(h1.matmul(t[3].clone()) + t[4].clone());
-                h2.matmul(t[5].clone()) + t[6].clone()
+                mlp_tensors(t[0].clone(), [1, 3, 5].into_iter().map(|l| (t[l].clone(), t[l + 1].clone())))
             };
             let mut w = SplitMix64::new(2);
             let weights: Vec<f32> = (0..n * o).map(|_| w.range(-1.0, 1.0) as f32).collect();
