@@ -11,7 +11,9 @@
 //! training seed alike), with a targets table per subject, and judges the ablation ordering on
 //! the means; the breakdown is the first subject's.
 //!
-//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D]`
+//! `--skirt auto|off` sets the skirt layer as `mannequin train --skirt` does (default auto).
+//!
+//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE]`
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -19,7 +21,7 @@ use std::time::{Duration, Instant};
 use burn::tensor::Device;
 use mannequin_avatar::evaluation::{AvatarScores, evaluate_avatar};
 use mannequin_avatar::{
-    Avatar, AvatarConfig, Canonical, Method, Timings, TrainOptions, Trainer, View, load_views,
+    Avatar, AvatarConfig, Canonical, Method, SkirtMode, Timings, TrainOptions, Trainer, View, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
@@ -48,15 +50,13 @@ fn run(
     name: &str,
     config: AvatarConfig,
     options: TrainOptions,
+    canonical: &Canonical,
     views: &[View],
     data: &Path,
     dir: &Path,
     breakdown: bool,
 ) -> (AvatarScores, f64) {
-    let model = BodyModel::default_body();
-    let betas = Dataset::open(data, 1).and_then(|d| d.split("train")).expect("train split").poses.betas;
-    let canonical = Canonical::from_body(&model, &betas, config.subdivisions).expect("canonical");
-    let avatar = Avatar::new(config, canonical, &Device::flex().autodiff()).expect("avatar");
+    let avatar = Avatar::new(config, canonical.clone(), &Device::flex().autodiff()).expect("avatar");
     let gaussians = avatar.num_gaussians();
     let iters = options.iterations;
     let mut trainer = Trainer::new(avatar, views.to_vec(), options).expect("trainer");
@@ -108,6 +108,7 @@ fn main() {
     let seed: u64 = arg("--seed", 0);
     let subjects: u64 = arg("--subjects", 1).max(1);
     let ablations = std::env::args().any(|a| a == "--ablations");
+    let skirt_mode: SkirtMode = arg("--skirt", SkirtMode::Auto);
     let dir = std::env::temp_dir().join(format!("mannequin-avatar-bench-{}", std::process::id()));
     let model = BodyModel::default_body();
     let mut table: Vec<(u64, AblationRow)> = Vec::new();
@@ -118,13 +119,25 @@ fn main() {
         let summary = generate(&model, &data, &options, &|| {}).expect("synth");
         println!("subject: synth seed {subject} ({:?}), {iters} iterations", summary.subject.outfit);
         let dataset = Dataset::open(&data, 1).expect("dataset");
-        let views = load_views(&dataset, &dataset.split("train").expect("split"), |_, _| {}).expect("views");
+        let split = dataset.split("train").expect("split");
+        let views = load_views(&dataset, &split, |_, _| {}).expect("views");
+        let (canonical, skirt) =
+            Canonical::for_subject(&model, &split.poses.betas, 0, &views, skirt_mode).expect("canonical");
+        if let Some(s) = &skirt {
+            println!(
+                "  skirt layer: {} vertices, hem {:.0} cm below the waist",
+                s.skirt.positions.len(),
+                100.0 * (s.waist - s.hem)
+            );
+        }
 
         let mut full = AvatarConfig::new(Method::Tavatar, subject);
         full.antialiased = std::env::args().any(|a| a == "--antialiased");
         full.dilation = arg("--dilation", full.dilation);
+        full.skirt_layer = skirt.is_some();
         let train = || TrainOptions::new(Method::Tavatar, iters, subject);
-        let (s, per_iter) = run("full", full.clone(), train(), &views, &data, &dir, subject == seed);
+        let (s, per_iter) =
+            run("full", full.clone(), train(), &canonical, &views, &data, &dir, subject == seed);
         let g = &s.geometry;
         let chamfer = g.chamfer_cm.unwrap_or(f64::NAN);
         targets(&s, &full, per_iter * 2000.0);
@@ -138,7 +151,7 @@ fn main() {
             for (name, change) in variants {
                 let (mut config, mut options) = (full.clone(), train());
                 change(&mut config, &mut options);
-                let (s, _) = run(name, config, options, &views, &data, &dir, false);
+                let (s, _) = run(name, config, options, &canonical, &views, &data, &dir, false);
                 results.push((
                     name,
                     s.geometry.normal_mse_x1e3.unwrap_or(f64::NAN),

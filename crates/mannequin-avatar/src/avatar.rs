@@ -58,6 +58,8 @@ pub struct Avatar {
     vertices: Tensor<2>,
     weights: Tensor<2>,
     posedirs: Option<Tensor<2>>,
+    /// The canonical mesh's offset gate [V, 1], where any vertex is gated.
+    offset_gate: Option<Tensor<2>>,
     rest_joints: Tensor<2>,
     offsets: Field,
     /// iHuman's colour encoder over canonical face centroids.
@@ -175,9 +177,15 @@ impl Avatar {
         let posedirs = (!canonical.posedirs.is_empty()).then(|| {
             tensor_from(canonical.posedirs.clone(), canonical.posedirs.len() / (3 * v), 3 * v, device)
         });
+        let offset_gate = canonical
+            .offset_gate
+            .iter()
+            .any(|&g| g != 1.0)
+            .then(|| tensor_from(canonical.offset_gate.clone(), v, 1, device));
         Ok(Self {
             index,
             vertices,
+            offset_gate,
             weights: tensor_from(canonical.weights.clone(), v, j, device),
             rest_joints: tensor_from(flat(&canonical.joints), j, 3, device),
             posedirs,
@@ -213,9 +221,13 @@ impl Avatar {
         slot.map(|i| self.params[i].value.clone())
     }
 
-    /// The offset field E_s(V_c) [V, 3] (Eq. 4).
+    /// The offset field E_s(V_c) [V, 3] (Eq. 4), gated where a garment layer hides the body.
     pub fn offsets(&self) -> Result<Tensor<2>, AvatarError> {
-        self.offsets.forward(&self.params)
+        let offsets = self.offsets.forward(&self.params)?;
+        Ok(match &self.offset_gate {
+            Some(gate) => offsets * gate.clone(),
+            None => offsets,
+        })
     }
 
     /// V_s = V_c + E_s(V_c) (Eq. 4).

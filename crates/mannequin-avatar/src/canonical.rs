@@ -9,6 +9,8 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;
 
 use crate::error::AvatarError;
+use crate::skirt_layer::{SkirtLayer, SkirtMode, fit_skirt};
+use crate::views::View;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Canonical {
@@ -22,6 +24,9 @@ pub struct Canonical {
     pub parents: Vec<Option<usize>>,
     /// Pose correctives, 9(J−1) × 3V, or empty.
     pub posedirs: Vec<f32>,
+    /// Per vertex, how much of the offset field applies: 0 where a garment layer hides the body
+    /// ([`crate::skirt_layer`]), 1 elsewhere.
+    pub offset_gate: Vec<f32>,
 }
 
 impl Canonical {
@@ -35,11 +40,33 @@ impl Canonical {
             joints: shaped.joints.iter().map(|j| j.to_array()).collect(),
             parents: model.parents().to_vec(),
             posedirs: model.posedirs().to_vec(),
+            offset_gate: vec![1.0; model.num_vertices()],
         };
         for _ in 0..subdivisions {
             c = c.subdivided();
         }
         Ok(c)
+    }
+
+    /// The subject's mesh: the shaped body, plus a skirt layer where `mode` and the views' masks
+    /// call for one (returned too, for reporting), then subdivided.
+    pub fn for_subject(
+        model: &BodyModel,
+        betas: &[f32],
+        subdivisions: usize,
+        views: &[View],
+        mode: SkirtMode,
+    ) -> Result<(Self, Option<SkirtLayer>), AvatarError> {
+        let body = Self::from_body(model, betas, 0)?;
+        let layer = fit_skirt(&body, views, mode)?;
+        let mut c = match &layer {
+            Some(l) => body.with_layer(l),
+            None => body,
+        };
+        for _ in 0..subdivisions {
+            c = c.subdivided();
+        }
+        Ok((c, layer))
     }
 
     pub fn num_vertices(&self) -> usize {
@@ -65,6 +92,7 @@ impl Canonical {
         let weights = s.interpolate(&self.weights, self.num_joints());
         Self {
             vertices,
+            offset_gate: s.interpolate(&self.offset_gate, 1),
             faces: s.faces,
             weights,
             joints: self.joints.clone(),
@@ -91,6 +119,7 @@ impl Canonical {
         );
         let rows = if self.posedirs.is_empty() { 0 } else { self.posedirs.len() / (3 * v) };
         w.add("posedirs", NpyArray::f32(vec![rows, 3 * v], self.posedirs.clone()));
+        w.add("offset_gate", NpyArray::f32(vec![v], self.offset_gate.clone()));
     }
 
     /// Reads what [`Canonical::write`] wrote, checking every shape against the vertex and joint
@@ -108,6 +137,9 @@ impl Canonical {
         let (_, posedirs) = f32s("posedirs", &[None, Some(3 * v)])?;
         let (_, faces) = npz.f64_with_shape("faces", &[None, Some(3)])?;
         let (_, parents) = npz.f64_with_shape("parents", &[Some(j)])?;
+        // Models saved before garment layers existed let the field move every vertex.
+        let offset_gate =
+            if npz.contains("offset_gate") { f32s("offset_gate", &[Some(v)])?.1 } else { vec![1.0; v] };
         let bad = |field: &str, reason: String| AvatarError::file(path, format!("{field}: {reason}"));
         let faces: Vec<[u32; 3]> = faces
             .chunks_exact(3)
@@ -130,6 +162,14 @@ impl Canonical {
             })
             .collect::<Result<_, _>>()?;
         let triples = |x: Vec<f32>| x.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
-        Ok(Self { vertices: triples(vertices), faces, weights, joints: triples(joints), parents, posedirs })
+        Ok(Self {
+            vertices: triples(vertices),
+            faces,
+            weights,
+            joints: triples(joints),
+            parents,
+            posedirs,
+            offset_gate,
+        })
     }
 }

@@ -64,6 +64,10 @@ pub struct AvatarConfig {
     /// Screen-filter variance in px² ([`AVATAR_DILATION`] for new avatars).
     #[serde(default = "legacy_dilation")]
     pub dilation: f64,
+    /// A skirt layer ([`crate::skirt_layer`]) over the body; models saved before it existed
+    /// have none.
+    #[serde(default)]
+    pub skirt_layer: bool,
     /// Seed of every random initialisation.
     pub seed: u64,
 }
@@ -90,6 +94,7 @@ impl AvatarConfig {
             hidden: 64,
             antialiased: false,
             dilation: AVATAR_DILATION,
+            skirt_layer: false,
             seed,
         }
     }

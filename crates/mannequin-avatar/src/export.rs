@@ -312,6 +312,7 @@ mod tests {
             joints: vec![[0.1, 0.1, 0.1]],
             parents: vec![None],
             posedirs: Vec::new(),
+            offset_gate: vec![1.0; 4],
         }
     }
 

@@ -23,6 +23,7 @@ pub mod mlp;
 pub mod params;
 pub mod predict;
 pub mod sh_colour;
+pub mod skirt_layer;
 pub mod trainer;
 pub mod views;
 
@@ -31,5 +32,6 @@ pub use canonical::Canonical;
 pub use config::{AVATAR_DILATION, AvatarConfig, Method};
 pub use error::AvatarError;
 pub use predict::{Prediction, predict, predict_split};
+pub use skirt_layer::SkirtMode;
 pub use trainer::{StepStats, Timings, TrainOptions, Trainer};
 pub use views::{View, frame_camera, load_views};

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
 use mannequin_avatar::trainer::checkpoint_path;
 use mannequin_avatar::{
-    Avatar, AvatarConfig, AvatarError, Canonical, Method, TrainOptions, Trainer, load_views,
+    Avatar, AvatarConfig, AvatarError, Canonical, Method, SkirtMode, TrainOptions, Trainer, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
@@ -58,6 +58,10 @@ pub struct Args {
     /// values widen silhouettes and shrink the fitted mesh).
     #[arg(long, default_value_t = mannequin_avatar::AVATAR_DILATION)]
     pub dilation: f64,
+    /// Skirt layer over the body: auto (where the masks fill the gap between the legs below
+    /// mid-thigh) or off.
+    #[arg(long, default_value = "auto")]
+    pub skirt: SkirtMode,
     /// Start over even if the model folder holds a checkpoint.
     #[arg(long)]
     pub restart: bool,
@@ -116,7 +120,17 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
     if views.iter().any(|v| !v.has_normals()) {
         tracing::warn!("{} has no normal maps: the normal loss is off", args.data.display());
     }
-    let config = avatar_config(args);
+    let (canonical, skirt) =
+        Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, args.skirt)?;
+    if let Some(s) = &skirt {
+        tracing::info!(
+            "the masks show a skirt: adding a layer of {} vertices from the waist to {:.0} cm below it (--skirt off trains without)",
+            s.skirt.positions.len(),
+            100.0 * (s.waist - s.hem)
+        );
+    }
+    let mut config = avatar_config(args);
+    config.skirt_layer = skirt.is_some();
     let checkpoint = checkpoint_path(&args.out);
     let resume = !args.restart && checkpoint.exists();
     if resume
@@ -128,7 +142,6 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
             args.out.display()
         );
     }
-    let canonical = Canonical::from_body(&model, &split.poses.betas, args.subdivide)?;
     let device = burn::tensor::Device::flex().autodiff();
     let avatar = Avatar::new(config, canonical, &device)?;
     let mut options = TrainOptions::new(args.method, args.iters, args.seed);

@@ -9,7 +9,7 @@ use mannequin_mesh::{TriMesh, UvLayout};
 use rayon::prelude::*;
 
 use super::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoothstep};
-use super::skirt::{Skirt, build_skirt};
+use super::skirt::{Skirt, build_skirt, lower_body, skirt_span};
 use super::subject::{Outfit, Subject};
 use super::texture::{BakeInput, SurfacePoint, bake};
 use crate::Camera;
@@ -84,10 +84,6 @@ impl PosedSequence {
     }
 }
 
-fn dominant_joint(weights: &[f32]) -> usize {
-    weights.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).map_or(0, |(j, _)| j)
-}
-
 /// Concatenates two textures side by side.
 fn side_by_side(a: &Image, b: &Image) -> Image {
     let (w, h) = (a.width + b.width, a.height.max(b.height));
@@ -144,23 +140,10 @@ impl Scene {
             })
             .collect();
 
-        let skirt = match subject.outfit {
-            Outfit::ShirtSkirt | Outfit::Dress => {
-                let legs =
-                    [joint::PELVIS, joint::L_HIP, joint::R_HIP, joint::L_KNEE, joint::R_KNEE, joint::SPINE1];
-                let inside: Vec<Vec3> = clothed_rest
-                    .iter()
-                    .enumerate()
-                    .filter(|(v, _)| legs.contains(&dominant_joint(&weights[v * joints..(v + 1) * joints])))
-                    .map(|(_, p)| Vec3::from(*p))
-                    .collect();
-                let knee = shaped.joints[joint::L_KNEE].y.min(shaped.joints[joint::R_KNEE].y);
-                let waist = shaped.joints[joint::SPINE1].y;
-                let hem = if subject.outfit == Outfit::Dress { knee - 0.1 } else { knee + 0.12 };
-                Some(build_skirt(&inside, shaped.joints[joint::PELVIS], waist, hem, 0.012, 0.35))
-            }
-            _ => None,
-        };
+        let skirt = skirt_span(subject.outfit, &shaped.joints).map(|(waist, hem)| {
+            let inside = lower_body(&clothed_rest, weights, joints);
+            build_skirt(&inside, shaped.joints[joint::PELVIS], waist, hem, 0.012, 0.35)
+        });
 
         let body_texture = bake(
             &BakeInput { uv: body_uv, faces: &model.faces, points: &points },

@@ -5,7 +5,8 @@
 use glam::Vec3;
 
 use super::clothing::smoothstep;
-use mannequin_body::smpl_joint::{L_HIP, PELVIS, R_HIP};
+use super::subject::Outfit;
+use mannequin_body::smpl_joint::{L_HIP, L_KNEE, PELVIS, R_HIP, R_KNEE, SPINE1};
 use mannequin_mesh::UvLayout;
 
 pub const SEGMENTS: usize = 64;
@@ -20,6 +21,33 @@ pub struct Skirt {
     pub uv: UvLayout,
     /// Per vertex, `(joint, weight)` pairs summing to one.
     pub weights: Vec<[(usize, f32); 3]>,
+}
+
+/// Waist and hem heights of `outfit`'s skirt on a body with rest `joints`, if it has one: from
+/// the lower spine to a hand above the knee (skirt) or below it (dress).
+pub fn skirt_span(outfit: Outfit, joints: &[Vec3]) -> Option<(f32, f32)> {
+    let knee = joints[L_KNEE].y.min(joints[R_KNEE].y);
+    let hem = match outfit {
+        Outfit::ShirtSkirt => knee + 0.12,
+        Outfit::Dress => knee - 0.1,
+        Outfit::TightShirtTrousers | Outfit::LooseShirtTrousers => return None,
+    };
+    Some((joints[SPINE1].y, hem))
+}
+
+/// The rest points a skirt must enclose: those whose strongest skinning joint (`weights` is
+/// V × `num_joints`) is the pelvis, a hip, a knee or the lower spine.
+pub fn lower_body(points: &[[f32; 3]], weights: &[f32], num_joints: usize) -> Vec<Vec3> {
+    let legs = [PELVIS, L_HIP, R_HIP, L_KNEE, R_KNEE, SPINE1];
+    points
+        .iter()
+        .zip(weights.chunks_exact(num_joints))
+        .filter(|(_, w)| {
+            let strongest = w.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).map_or(0, |(j, _)| j);
+            legs.contains(&strongest)
+        })
+        .map(|(p, _)| Vec3::from(*p))
+        .collect()
 }
 
 /// Builds a skirt from `waist` down to `hem` height around the vertical axis through `centre`,

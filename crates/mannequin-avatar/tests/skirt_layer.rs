@@ -1,0 +1,71 @@
+//! The skirt layer against the synthetic generator's ground truth: found on a dress subject with
+//! the generator's hem, lying on the ground-truth skirt once posed, and not found on trousers.
+
+use std::path::PathBuf;
+
+use burn::tensor::Device;
+use glam::Vec3;
+use mannequin_avatar::skirt_layer::{SkirtMode, fit_skirt};
+use mannequin_avatar::{Avatar, AvatarConfig, Canonical, Method, View, load_views};
+use mannequin_body::BodyModel;
+use mannequin_data::metrics::surface_distance::TriangleBvh;
+use mannequin_data::synth::skirt::skirt_span;
+use mannequin_data::synth::subject::Outfit;
+use mannequin_data::synth::{SynthOptions, generate};
+use mannequin_data::{Dataset, Split};
+
+/// A small subject: 256 px keeps a pixel near 8 mm, the carving's resolution.
+fn subject(seed: u64, expected: Outfit) -> (PathBuf, Dataset, Split, Vec<View>) {
+    let dir = std::env::temp_dir().join(format!("mannequin-skirt-{seed}-{}", std::process::id()));
+    let options = SynthOptions {
+        seed,
+        size: 256,
+        supersample: 1,
+        capture_frames: 40,
+        train_frames: 32,
+        view_poses: 1,
+        motion_frames: 1,
+    };
+    let summary = generate(&BodyModel::default_body(), &dir, &options, &|| {}).expect("synthetic subject");
+    assert_eq!(summary.subject.outfit, expected, "seed {seed}'s outfit changed; pick another seed");
+    let dataset = Dataset::open(&dir, 1).unwrap();
+    let split = dataset.split("train").unwrap();
+    let views = load_views(&dataset, &split, |_, _| {}).unwrap();
+    (dir, dataset, split, views)
+}
+
+#[test]
+fn a_dress_gets_a_layer_on_the_ground_truth_skirt() {
+    let (dir, dataset, split, views) = subject(1, Outfit::Dress);
+    let body = Canonical::from_body(&BodyModel::default_body(), &split.poses.betas, 0).unwrap();
+    assert!(fit_skirt(&body, &views, SkirtMode::Off).unwrap().is_none(), "off means off");
+    let layer = fit_skirt(&body, &views, SkirtMode::Auto).unwrap().expect("a skirt layer");
+    let joints: Vec<Vec3> = body.joints.iter().map(|&j| Vec3::from(j)).collect();
+    let (_, hem) = skirt_span(Outfit::Dress, &joints).unwrap();
+    assert!((layer.hem - hem).abs() < 0.05, "hem at {} m, the generator's at {hem} m", layer.hem);
+
+    // Posed by the avatar (zero offsets at initialisation) into a training frame, the layer's
+    // vertices lie on the ground-truth clothed mesh.
+    let skirt_vertices = layer.skirt.positions.len();
+    let canonical = body.with_layer(&layer);
+    let avatar = Avatar::new(AvatarConfig::new(Method::Tavatar, 0), canonical, &Device::flex()).unwrap();
+    let frame = 0;
+    let posed = avatar.pose_mesh(&views[frame].pose, views[frame].transl).unwrap();
+    let gt = dataset.mesh(split.frames[frame]).unwrap().expect("ground-truth mesh");
+    let bvh = TriangleBvh::new(&gt.mesh.positions, &gt.mesh.faces);
+    let distances: Vec<f64> = posed[posed.len() - skirt_vertices..]
+        .iter()
+        .map(|p| bvh.closest(Vec3::from(*p).as_dvec3()).unwrap().distance_squared.sqrt())
+        .collect();
+    let mean = distances.iter().sum::<f64>() / distances.len() as f64;
+    assert!(mean < 0.012, "the layer lies {:.1} mm from the ground truth on average", 1e3 * mean);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn trousers_get_no_layer() {
+    let (dir, _, split, views) = subject(0, Outfit::LooseShirtTrousers);
+    let body = Canonical::from_body(&BodyModel::default_body(), &split.poses.betas, 0).unwrap();
+    assert!(fit_skirt(&body, &views, SkirtMode::Auto).unwrap().is_none());
+    std::fs::remove_dir_all(dir).ok();
+}
