@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use mannequin_body::kinematics::{skinning_transforms, world_transforms};
 use mannequin_body::rodrigues::rodrigues;
 use mannequin_body::smpl_joint::{L_ANKLE, L_HIP, L_KNEE, PELVIS, R_ANKLE, R_HIP, R_KNEE, SPINE1};
-use mannequin_data::synth::skirt::{RINGS, SEGMENTS, Skirt, build_skirt, lower_body};
+use mannequin_data::synth::skirt::{RingLayout, Skirt, build_skirt, lower_body};
 
 use crate::canonical::Canonical;
 use crate::error::AvatarError;
@@ -31,8 +31,14 @@ const VIEW_STRIDE: usize = 2;
 /// ring above; below a hem the gap between the legs opens and the front and back collapse.
 const RING_KEEPS: f32 = 0.9;
 const KEEP_RATIO: f32 = 0.85;
-/// The provisional skirt reaches this far above the ankles while the hem is searched (m).
+/// The provisional skirt reaches this far above the ankles while the hem is searched (m), on a
+/// grid of this many segments and rings (about 3 cm between rings).
 const ANKLE_CLEARANCE: f32 = 0.1;
+const PROVISIONAL: (usize, usize) = (64, 28);
+/// Vertices around each ring of the fitted layer: about 3 cm apart at a dress's hem.
+const SEGMENTS: usize = 96;
+/// Heights at which the fitted profile is integrated to place the rings.
+const PROFILE_SAMPLES: usize = 256;
 
 /// Whether to add the layer: when the masks show a skirt, or never.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,10 +140,11 @@ fn carve_all(hull: &Silhouettes, skirt: &Skirt, centre: Vec3) -> Vec<Option<f32>
 }
 
 /// Number of rings, from the waist, that keep their radius (see `RING_KEEPS`).
-fn skirt_rings(carved: &[Option<f32>]) -> usize {
-    let ring = |r: usize| &carved[r * SEGMENTS..(r + 1) * SEGMENTS];
+fn skirt_rings(carved: &[Option<f32>], layout: &RingLayout) -> usize {
+    let n = layout.segments;
+    let ring = |r: usize| &carved[r * n..(r + 1) * n];
     let kept = |r: usize| {
-        let n = if r == 0 {
+        let count = if r == 0 {
             ring(0).iter().filter(|c| c.is_some()).count()
         } else {
             ring(r)
@@ -146,9 +153,53 @@ fn skirt_rings(carved: &[Option<f32>]) -> usize {
                 .filter(|(c, above)| matches!((c, above), (Some(c), Some(a)) if *c >= KEEP_RATIO * a))
                 .count()
         };
-        n as f32 >= RING_KEEPS * SEGMENTS as f32
+        count as f32 >= RING_KEEPS * n as f32
     };
-    (0..=RINGS).take_while(|&r| kept(r)).count()
+    (0..layout.rings.len()).take_while(|&r| kept(r)).count()
+}
+
+/// Rings spaced like the segments around them (spacing 2πr/N at radius r), so the layer's
+/// triangles are near-isotropic from the narrow waist to the wide hem. With one fixed spacing
+/// the hem's triangles came out 4.4 × 2.1 cm, and Tavatar's vertex Gaussians, sized by the
+/// shortest edge (Eq. 11), left holes between them. `radius(s)` is the mean radius at fraction
+/// `s` from waist to hem.
+fn isotropic_layout(length: f32, radius: impl Fn(f32) -> f32) -> RingLayout {
+    let step = |s: f32| length / (std::f32::consts::TAU * radius(s).max(1e-3) / SEGMENTS as f32);
+    let ds = 1.0 / PROFILE_SAMPLES as f32;
+    let mut cumulative = vec![0.0f32];
+    for i in 0..PROFILE_SAMPLES {
+        let mid = (i as f32 + 0.5) * ds;
+        cumulative.push(cumulative[i] + step(mid) * ds);
+    }
+    let total = cumulative[PROFILE_SAMPLES];
+    let gaps = total.round().max(1.0) as usize;
+    let rings = (0..=gaps)
+        .map(|j| {
+            let target = j as f32 / gaps as f32 * total;
+            let i = cumulative.partition_point(|&c| c < target).clamp(1, PROFILE_SAMPLES);
+            let (a, b) = (cumulative[i - 1], cumulative[i]);
+            let t = if b > a { (target - a) / (b - a) } else { 0.0 };
+            ((i - 1) as f32 + t.clamp(0.0, 1.0)) * ds
+        })
+        .collect();
+    RingLayout { segments: SEGMENTS, rings }
+}
+
+/// Mean of the carved radii of each ring (the body's outline where a ring carved nothing).
+fn ring_radii(skirt: &Skirt, carved: &[Option<f32>], centre: Vec3) -> Vec<f32> {
+    let n = skirt.layout.segments;
+    (0..skirt.layout.rings.len())
+        .map(|r| {
+            let sum: f32 = (0..n)
+                .map(|k| {
+                    let p = Vec3::from(skirt.positions[r * n + k]);
+                    let r0 = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z).length();
+                    carved[r * n + k].unwrap_or(r0).max(r0)
+                })
+                .sum();
+            sum / n as f32
+        })
+        .collect()
 }
 
 /// Fits the layer to `views`' masks, or returns `None` when `mode` is off or the masks show the
@@ -176,24 +227,36 @@ pub fn fit_skirt(
 
     // A long provisional skirt finds the hem: the last ring that keeps its radius.
     let lowest = ankles + ANKLE_CLEARANCE;
-    let provisional = build_skirt(&inside, centre, waist, lowest, 0.0, 0.0);
-    let rings = skirt_rings(&carve_all(&hull, &provisional, centre));
-    let hem = waist - (rings.saturating_sub(1)) as f32 / RINGS as f32 * (waist - lowest);
+    let coarse = RingLayout::uniform(PROVISIONAL.0, PROVISIONAL.1);
+    let provisional = build_skirt(&inside, centre, (waist, lowest), (0.0, 0.0), &coarse);
+    let carved = carve_all(&hull, &provisional, centre);
+    let rings = skirt_rings(&carved, &coarse);
+    let hem_s = coarse.rings[rings.saturating_sub(1)];
+    let hem = waist - hem_s * (waist - lowest);
     if hem >= mid_thigh {
         return Ok(None);
     }
 
-    let mut skirt = build_skirt(&inside, centre, waist, hem, 0.0, 0.0);
+    // The provisional radii, read over the skirt's length, place the final rings.
+    let profile = ring_radii(&provisional, &carved, centre);
+    let layout = isotropic_layout(waist - hem, |s| {
+        let x = (s * hem_s * PROVISIONAL.1 as f32).clamp(0.0, PROVISIONAL.1 as f32);
+        let (i, t) = (x.floor() as usize, x.fract());
+        let next = profile[(i + 1).min(PROVISIONAL.1)];
+        profile[i] * (1.0 - t) + next * t
+    });
+    let mut skirt = build_skirt(&inside, centre, (waist, hem), (0.0, 0.0), &layout);
     let carved = carve_all(&hull, &skirt, centre);
+    let n = layout.segments;
     for (k, p) in skirt.positions.iter_mut().enumerate() {
         // Smooth along the ring ([1, 2, 1] / 4) over the pixel steps of the carving, and never
         // inside the body's own outline.
-        let (ring, seg) = (k / SEGMENTS, k % SEGMENTS);
-        let at = |s: usize| carved[ring * SEGMENTS + s % SEGMENTS];
+        let (ring, seg) = (k / n, k % n);
+        let at = |s: usize| carved[layout.vertex(ring, s)];
         let d = Vec3::new(p[0] - centre.x, 0.0, p[2] - centre.z);
         let r0 = d.length();
         let radius = |c: Option<f32>| c.unwrap_or(r0).max(r0);
-        let r = 0.25 * (radius(at(seg + SEGMENTS - 1)) + 2.0 * radius(at(seg)) + radius(at(seg + 1)));
+        let r = 0.25 * (radius(at(seg + n - 1)) + 2.0 * radius(at(seg)) + radius(at(seg + 1)));
         let q = Vec3::new(centre.x, p[1], centre.z) + r * d.normalize_or_zero();
         *p = q.to_array();
     }
@@ -207,11 +270,13 @@ impl SkirtLayer {
         if p.y >= self.waist || p.y <= self.hem {
             return false;
         }
-        let ring = ((self.waist - p.y) / (self.waist - self.hem) * RINGS as f32).round() as usize;
+        let layout = &self.skirt.layout;
+        let below_waist = (self.waist - p.y) / (self.waist - self.hem);
+        let ring = layout.rings.partition_point(|&s| s <= below_waist).saturating_sub(1);
         let d = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z);
         let turn = (d.z.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0);
-        let segment = (turn * SEGMENTS as f32).round() as usize % SEGMENTS;
-        let s = Vec3::from(self.skirt.positions[ring.min(RINGS) * SEGMENTS + segment]);
+        let segment = (turn * layout.segments as f32).round() as usize;
+        let s = Vec3::from(self.skirt.positions[layout.vertex(ring, segment)]);
         d.length() < Vec3::new(s.x - centre.x, 0.0, s.z - centre.z).length()
     }
 }

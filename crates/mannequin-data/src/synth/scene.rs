@@ -9,7 +9,7 @@ use mannequin_mesh::{TriMesh, UvLayout};
 use rayon::prelude::*;
 
 use super::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoothstep};
-use super::skirt::{Skirt, build_skirt, lower_body, skirt_span};
+use super::skirt::{RingLayout, Skirt, build_skirt, lower_body, skirt_span};
 use super::subject::{Outfit, Subject};
 use super::texture::{BakeInput, SurfacePoint, bake};
 use crate::Camera;
@@ -142,7 +142,13 @@ impl Scene {
 
         let skirt = skirt_span(subject.outfit, &shaped.joints).map(|(waist, hem)| {
             let inside = lower_body(&clothed_rest, weights, joints);
-            build_skirt(&inside, shaped.joints[joint::PELVIS], waist, hem, 0.012, 0.35)
+            build_skirt(
+                &inside,
+                shaped.joints[joint::PELVIS],
+                (waist, hem),
+                (0.012, 0.35),
+                &RingLayout::uniform(64, 28),
+            )
         });
 
         let body_texture = bake(

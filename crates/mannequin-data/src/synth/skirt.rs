@@ -9,8 +9,6 @@ use super::subject::Outfit;
 use mannequin_body::smpl_joint::{L_HIP, L_KNEE, PELVIS, R_HIP, R_KNEE, SPINE1};
 use mannequin_mesh::UvLayout;
 
-pub const SEGMENTS: usize = 64;
-pub const RINGS: usize = 28;
 /// Angular bins for measuring the body's cross-section.
 const BINS: usize = 48;
 
@@ -21,6 +19,27 @@ pub struct Skirt {
     pub uv: UvLayout,
     /// Per vertex, `(joint, weight)` pairs summing to one.
     pub weights: Vec<[(usize, f32); 3]>,
+    pub layout: RingLayout,
+}
+
+/// Where the skirt's vertices sit: `segments` around each ring, and the rings at fractions of
+/// the length from the waist (0) to the hem (1), increasing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RingLayout {
+    pub segments: usize,
+    pub rings: Vec<f32>,
+}
+
+impl RingLayout {
+    /// `rings + 1` evenly spaced rings: the generator's 64 × 29 grid.
+    pub fn uniform(segments: usize, rings: usize) -> Self {
+        Self { segments, rings: (0..=rings).map(|r| r as f32 / rings as f32).collect() }
+    }
+
+    /// Index of vertex `segment` (taken around the ring) of ring `ring`.
+    pub fn vertex(&self, ring: usize, segment: usize) -> usize {
+        ring * self.segments + segment % self.segments
+    }
 }
 
 /// Waist and hem heights of `outfit`'s skirt on a body with rest `joints`, if it has one: from
@@ -52,35 +71,42 @@ pub fn lower_body(points: &[[f32; 3]], weights: &[f32], num_joints: usize) -> Ve
 
 /// Builds a skirt from `waist` down to `hem` height around the vertical axis through `centre`,
 /// enclosing `body` (the rest vertices considered, e.g. pelvis and legs) with `ease` metres of
-/// room and a flare of `flare` metres per metre of length.
-pub fn build_skirt(body: &[Vec3], centre: Vec3, waist: f32, hem: f32, ease: f32, flare: f32) -> Skirt {
-    let length = waist - hem;
+/// room and a flare of `flare` metres per metre of length, with its vertices on `layout`.
+pub fn build_skirt(
+    body: &[Vec3],
+    centre: Vec3,
+    (waist, hem): (f32, f32),
+    (ease, flare): (f32, f32),
+    layout: &RingLayout,
+) -> Skirt {
+    let (length, rings, segments) = (waist - hem, layout.rings.len(), layout.segments);
     // Body radius per ring and angle bin, from points at or above the ring (down to the hem),
     // so the skirt never narrows below the widest part it has passed.
-    let mut radius = vec![[0.0f32; BINS]; RINGS + 1];
+    let mut radius = vec![[0.0f32; BINS]; rings];
     for p in body {
         if p.y > waist + 0.02 || p.y < hem - 0.05 {
             continue;
         }
         let d = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z);
         let bin = (((d.z.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0)) * BINS as f32) as usize % BINS;
-        let ring = (((waist - p.y) / length * RINGS as f32).max(0.0) as usize).min(RINGS);
+        // The last ring at or above the point.
+        let below_waist = (waist - p.y) / length;
+        let ring = layout.rings.partition_point(|&s| s <= below_waist).saturating_sub(1).min(rings - 1);
         radius[ring][bin] = radius[ring][bin].max(d.length());
     }
-    for r in 1..=RINGS {
+    for r in 1..rings {
         let (above, below) = radius.split_at_mut(r);
         for (b, a) in below[0].iter_mut().zip(&above[r - 1]) {
             *b = b.max(*a);
         }
     }
-    let mut positions = Vec::with_capacity((RINGS + 1) * SEGMENTS);
+    let mut positions = Vec::with_capacity(rings * segments);
     let mut weights = Vec::with_capacity(positions.capacity());
-    let mut coords = Vec::with_capacity((RINGS + 1) * (SEGMENTS + 1));
-    for (r, ring) in radius.iter().enumerate() {
-        let s = r as f32 / RINGS as f32;
+    let mut coords = Vec::with_capacity(rings * (segments + 1));
+    for (ring, &s) in radius.iter().zip(&layout.rings) {
         let y = waist - s * length;
-        for k in 0..SEGMENTS {
-            let theta = std::f32::consts::TAU * k as f32 / SEGMENTS as f32;
+        for k in 0..segments {
+            let theta = std::f32::consts::TAU * k as f32 / segments as f32;
             // Smooth the measured profile over neighbouring bins.
             let bin = theta / std::f32::consts::TAU * BINS as f32;
             let rad = (-2..=2)
@@ -94,16 +120,16 @@ pub fn build_skirt(body: &[Vec3], centre: Vec3, waist: f32, hem: f32, ease: f32,
             let legs = 0.5 * smoothstep(0.0, 1.0, s);
             weights.push([(PELVIS, 1.0 - legs), (L_HIP, legs * side), (R_HIP, legs * (1.0 - side))]);
         }
-        for k in 0..=SEGMENTS {
-            coords.push([k as f32 / SEGMENTS as f32, 1.0 - s]);
+        for k in 0..=segments {
+            coords.push([k as f32 / segments as f32, 1.0 - s]);
         }
     }
-    let mut faces = Vec::with_capacity(2 * RINGS * SEGMENTS);
+    let mut faces = Vec::with_capacity(2 * (rings - 1) * segments);
     let mut uv_faces = Vec::with_capacity(faces.capacity());
-    for r in 0..RINGS {
-        for k in 0..SEGMENTS {
-            let v = |rr: usize, kk: usize| (rr * SEGMENTS + kk % SEGMENTS) as u32;
-            let t = |rr: usize, kk: usize| (rr * (SEGMENTS + 1) + kk) as u32;
+    for r in 0..rings - 1 {
+        for k in 0..segments {
+            let v = |rr: usize, kk: usize| layout.vertex(rr, kk) as u32;
+            let t = |rr: usize, kk: usize| (rr * (segments + 1) + kk) as u32;
             // Counter-clockwise seen from outside, so face normals point outward.
             faces.push([v(r, k), v(r, k + 1), v(r + 1, k + 1)]);
             faces.push([v(r, k), v(r + 1, k + 1), v(r + 1, k)]);
@@ -111,7 +137,7 @@ pub fn build_skirt(body: &[Vec3], centre: Vec3, waist: f32, hem: f32, ease: f32,
             uv_faces.push([t(r, k), t(r + 1, k + 1), t(r + 1, k)]);
         }
     }
-    Skirt { positions, faces, uv: UvLayout { coords, faces: uv_faces }, weights }
+    Skirt { positions, faces, uv: UvLayout { coords, faces: uv_faces }, weights, layout: layout.clone() }
 }
 
 #[cfg(test)]
@@ -127,8 +153,9 @@ mod tests {
                 Vec3::new(0.1 + 0.15 * a.cos(), (i % 100) as f32 / 100.0, 0.15 * a.sin())
             })
             .collect();
-        let s = build_skirt(&body, Vec3::new(0.1, 0.0, 0.0), 0.9, 0.4, 0.01, 0.2);
-        assert_eq!(s.positions.len(), (RINGS + 1) * SEGMENTS);
+        let layout = RingLayout::uniform(64, 28);
+        let s = build_skirt(&body, Vec3::new(0.1, 0.0, 0.0), (0.9, 0.4), (0.01, 0.2), &layout);
+        assert_eq!(s.positions.len(), 29 * 64);
         for p in &s.positions {
             let r = ((p[0] - 0.1).powi(2) + p[2].powi(2)).sqrt();
             assert!(r >= 0.16 - 1e-4, "{p:?} radius {r}");
