@@ -44,18 +44,24 @@ fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
 /// Iterations timed for the breakdown, after 3 untimed warm-up iterations.
 const TIMED: usize = 30;
 
+/// One synthetic subject: its mesh, training views, dataset folder and the bench's folder.
+struct Subject<'a> {
+    canonical: &'a Canonical,
+    views: &'a [View],
+    data: &'a Path,
+    dir: &'a Path,
+}
+
 /// Trains one configuration, printing the breakdown for the first, and returns its scores and
 /// the seconds per iteration.
 fn run(
     name: &str,
     config: AvatarConfig,
     options: TrainOptions,
-    canonical: &Canonical,
-    views: &[View],
-    data: &Path,
-    dir: &Path,
+    subject: &Subject,
     breakdown: bool,
 ) -> (AvatarScores, f64) {
+    let Subject { canonical, views, data, dir } = *subject;
     let avatar = Avatar::new(config, canonical.clone(), &Device::flex().autodiff()).expect("avatar");
     let gaussians = avatar.num_gaussians();
     let iters = options.iterations;
@@ -131,13 +137,13 @@ fn main() {
             );
         }
 
+        let here = Subject { canonical: &canonical, views: &views, data: &data, dir: &dir };
         let mut full = AvatarConfig::new(Method::Tavatar, subject);
         full.antialiased = std::env::args().any(|a| a == "--antialiased");
         full.dilation = arg("--dilation", full.dilation);
         full.skirt_layer = skirt.is_some();
         let train = || TrainOptions::new(Method::Tavatar, iters, subject);
-        let (s, per_iter) =
-            run("full", full.clone(), train(), &canonical, &views, &data, &dir, subject == seed);
+        let (s, per_iter) = run("full", full.clone(), train(), &here, subject == seed);
         let g = &s.geometry;
         let chamfer = g.chamfer_cm.unwrap_or(f64::NAN);
         targets(&s, &full, per_iter * 2000.0);
@@ -151,7 +157,7 @@ fn main() {
             for (name, change) in variants {
                 let (mut config, mut options) = (full.clone(), train());
                 change(&mut config, &mut options);
-                let (s, _) = run(name, config, options, &canonical, &views, &data, &dir, false);
+                let (s, _) = run(name, config, options, &here, false);
                 results.push((
                     name,
                     s.geometry.normal_mse_x1e3.unwrap_or(f64::NAN),

@@ -1,5 +1,6 @@
 //! The skirt layer against the synthetic generator's ground truth: found on a dress subject with
-//! the generator's hem, lying on the ground-truth skirt once posed, and not found on trousers.
+//! the generator's hem, lying on the ground-truth skirt once posed, the thighs under it held to
+//! the template, and not found on trousers.
 
 use std::path::PathBuf;
 
@@ -47,7 +48,31 @@ fn a_dress_gets_a_layer_on_the_ground_truth_skirt() {
     // Posed by the avatar (zero offsets at initialisation) into a training frame, the layer's
     // vertices lie on the ground-truth clothed mesh.
     let skirt_vertices = layer.skirt.positions.len();
-    let canonical = body.with_layer(&layer);
+    let canonical = body.clone().with_layer(&layer);
+
+    // The body under the layer keeps the template: the thighs are gated, nothing outside the
+    // waist-to-hem band is.
+    let j = body.num_joints();
+    let thighs: Vec<usize> = (0..body.num_vertices())
+        .filter(|&v| {
+            let w = &body.weights[v * j..(v + 1) * j];
+            let y = body.vertices[v][1];
+            (w[1] > 0.9 || w[2] > 0.9) && y < layer.waist - 0.05 && y > layer.hem + 0.05
+        })
+        .collect();
+    let gated = thighs.iter().filter(|&&v| canonical.offset_gate[v] == 0.0).count();
+    assert!(
+        !thighs.is_empty() && gated as f64 >= 0.95 * thighs.len() as f64,
+        "{gated} of {} thighs",
+        thighs.len()
+    );
+    for v in 0..body.num_vertices() {
+        let y = body.vertices[v][1];
+        if y > layer.waist || y < layer.hem {
+            assert_eq!(canonical.offset_gate[v], 1.0, "vertex {v} at {y} m is outside the layer");
+        }
+    }
+    assert!(canonical.offset_gate[body.num_vertices()..].iter().all(|&g| g == 1.0));
     let avatar = Avatar::new(AvatarConfig::new(Method::Tavatar, 0), canonical, &Device::flex()).unwrap();
     let frame = 0;
     let posed = avatar.pose_mesh(&views[frame].pose, views[frame].transl).unwrap();
