@@ -6,11 +6,11 @@
 //! to the pelvis and nearer hip at the hem, with each vertex's radius carved to the visual hull
 //! of the training masks. The offset field then refines it like the rest of the mesh.
 
-use glam::{Affine3A, DVec3, Mat3, Vec3};
+use glam::{Affine3A, DVec3, Vec3};
 use rayon::prelude::*;
 
 use mannequin_body::kinematics::{skinning_transforms, world_transforms};
-use mannequin_body::rodrigues::rodrigues;
+use mannequin_body::lbs::frame_rotations;
 use mannequin_body::smpl_joint::{L_ANKLE, L_HIP, L_KNEE, PELVIS, R_ANKLE, R_HIP, R_KNEE, SPINE1};
 use mannequin_data::synth::skirt::{RingLayout, Skirt, build_skirt, lower_body};
 
@@ -66,6 +66,11 @@ pub struct SkirtLayer {
     pub hem: f32,
 }
 
+/// The horizontal offset of `p` from the skirt's vertical axis through `centre`.
+fn horizontal(p: Vec3, centre: Vec3) -> Vec3 {
+    Vec3::new(p.x - centre.x, 0.0, p.z - centre.z)
+}
+
 /// The training views' skinning transforms, for testing rest-pose points against their masks.
 struct Silhouettes<'a> {
     views: Vec<(&'a View, Vec<Affine3A>)>,
@@ -78,9 +83,7 @@ impl<'a> Silhouettes<'a> {
             .iter()
             .step_by(VIEW_STRIDE)
             .map(|v| {
-                let rotations: Vec<Mat3> =
-                    v.pose.chunks_exact(3).map(|r| rodrigues([r[0], r[1], r[2]])).collect();
-                let world = world_transforms(&body.parents, &rotations, &rest);
+                let world = world_transforms(&body.parents, &frame_rotations(&v.pose), &rest);
                 (v, skinning_transforms(&world, &rest))
             })
             .collect();
@@ -105,7 +108,7 @@ impl<'a> Silhouettes<'a> {
     /// whose point is inside the hull, searched out to `REACH` past the vertex; `None` when the
     /// whole ray is outside.
     fn carve(&self, centre: Vec3, vertex: Vec3, weights: &[(usize, f32); 3]) -> Option<f32> {
-        let d = Vec3::new(vertex.x - centre.x, 0.0, vertex.z - centre.z);
+        let d = horizontal(vertex, centre);
         let (r0, dir) = (d.length(), d.normalize_or_zero());
         let steps = ((r0 + REACH) / STEP) as usize;
         (1..=steps).map(|k| k as f32 * STEP).rev().find(|&r| {
@@ -136,6 +139,20 @@ fn carve_all(hull: &Silhouettes, skirt: &Skirt, centre: Vec3) -> Vec<Option<f32>
         .par_iter()
         .zip(&skirt.weights)
         .map(|(p, w)| hull.carve(centre, Vec3::from(*p), w))
+        .collect()
+}
+
+/// Every vertex's carved radius, never inside the body's own outline (its radius as built),
+/// which it keeps where it carved nothing.
+fn outline_radii(skirt: &Skirt, carved: &[Option<f32>], centre: Vec3) -> Vec<f32> {
+    skirt
+        .positions
+        .iter()
+        .zip(carved)
+        .map(|(p, c)| {
+            let r0 = horizontal(Vec3::from(*p), centre).length();
+            c.unwrap_or(r0).max(r0)
+        })
         .collect()
 }
 
@@ -185,23 +202,6 @@ fn isotropic_layout(length: f32, radius: impl Fn(f32) -> f32) -> RingLayout {
     RingLayout { segments: SEGMENTS, rings }
 }
 
-/// Mean of the carved radii of each ring (the body's outline where a ring carved nothing).
-fn ring_radii(skirt: &Skirt, carved: &[Option<f32>], centre: Vec3) -> Vec<f32> {
-    let n = skirt.layout.segments;
-    (0..skirt.layout.rings.len())
-        .map(|r| {
-            let sum: f32 = (0..n)
-                .map(|k| {
-                    let p = Vec3::from(skirt.positions[r * n + k]);
-                    let r0 = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z).length();
-                    carved[r * n + k].unwrap_or(r0).max(r0)
-                })
-                .sum();
-            sum / n as f32
-        })
-        .collect()
-}
-
 /// Fits the layer to `views`' masks, or returns `None` when `mode` is off or the masks show the
 /// gap between the legs above mid-thigh (trousers or shorts).
 pub fn fit_skirt(
@@ -238,7 +238,11 @@ pub fn fit_skirt(
     }
 
     // The provisional radii, read over the skirt's length, place the final rings.
-    let profile = ring_radii(&provisional, &carved, centre);
+    let n = coarse.segments;
+    let profile: Vec<f32> = outline_radii(&provisional, &carved, centre)
+        .chunks_exact(n)
+        .map(|ring| ring.iter().sum::<f32>() / n as f32)
+        .collect();
     let layout = isotropic_layout(waist - hem, |s| {
         let x = (s * hem_s * PROVISIONAL.1 as f32).clamp(0.0, PROVISIONAL.1 as f32);
         let (i, t) = (x.floor() as usize, x.fract());
@@ -252,13 +256,11 @@ pub fn fit_skirt(
         // Smooth along the ring ([1, 2, 1] / 4) over the pixel steps of the carving, and never
         // inside the body's own outline.
         let (ring, seg) = (k / n, k % n);
-        let at = |s: usize| carved[layout.vertex(ring, s)];
-        let d = Vec3::new(p[0] - centre.x, 0.0, p[2] - centre.z);
+        let d = horizontal(Vec3::from(*p), centre);
         let r0 = d.length();
-        let radius = |c: Option<f32>| c.unwrap_or(r0).max(r0);
-        let r = 0.25 * (radius(at(seg + n - 1)) + 2.0 * radius(at(seg)) + radius(at(seg + 1)));
-        let q = Vec3::new(centre.x, p[1], centre.z) + r * d.normalize_or_zero();
-        *p = q.to_array();
+        let at = |s: usize| carved[layout.vertex(ring, s)].unwrap_or(r0).max(r0);
+        let r = 0.25 * (at(seg + n - 1) + 2.0 * at(seg) + at(seg + 1));
+        *p = (Vec3::new(centre.x, p[1], centre.z) + r * d.normalize_or_zero()).to_array();
     }
     Ok(Some(SkirtLayer { skirt, waist, hem }))
 }
@@ -271,13 +273,12 @@ impl SkirtLayer {
             return false;
         }
         let layout = &self.skirt.layout;
-        let below_waist = (self.waist - p.y) / (self.waist - self.hem);
-        let ring = layout.rings.partition_point(|&s| s <= below_waist).saturating_sub(1);
-        let d = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z);
+        let ring = layout.ring_at((self.waist - p.y) / (self.waist - self.hem));
+        let d = horizontal(p, centre);
         let turn = (d.z.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0);
         let segment = (turn * layout.segments as f32).round() as usize;
         let s = Vec3::from(self.skirt.positions[layout.vertex(ring, segment)]);
-        d.length() < Vec3::new(s.x - centre.x, 0.0, s.z - centre.z).length()
+        d.length() < horizontal(s, centre).length()
     }
 }
 

@@ -110,7 +110,7 @@ fn frame_count(model: &BodyModel, poses: &[f32], transl: &[f32]) -> Result<usize
 }
 
 /// Per-frame local rotation matrices, F × J.
-fn frame_rotations(poses: &[f32]) -> Vec<Mat3> {
+pub fn frame_rotations(poses: &[f32]) -> Vec<Mat3> {
     poses.chunks_exact(3).map(|r| rodrigues([r[0], r[1], r[2]])).collect()
 }
 

@@ -36,6 +36,11 @@ impl RingLayout {
         Self { segments, rings: (0..=rings).map(|r| r as f32 / rings as f32).collect() }
     }
 
+    /// The last ring at or above `fraction` of the length below the waist.
+    pub fn ring_at(&self, fraction: f32) -> usize {
+        self.rings.partition_point(|&s| s <= fraction).saturating_sub(1).min(self.rings.len() - 1)
+    }
+
     /// Index of vertex `segment` (taken around the ring) of ring `ring`.
     pub fn vertex(&self, ring: usize, segment: usize) -> usize {
         ring * self.segments + segment % self.segments
@@ -89,9 +94,7 @@ pub fn build_skirt(
         }
         let d = Vec3::new(p.x - centre.x, 0.0, p.z - centre.z);
         let bin = (((d.z.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0)) * BINS as f32) as usize % BINS;
-        // The last ring at or above the point.
-        let below_waist = (waist - p.y) / length;
-        let ring = layout.rings.partition_point(|&s| s <= below_waist).saturating_sub(1).min(rings - 1);
+        let ring = layout.ring_at((waist - p.y) / length);
         radius[ring][bin] = radius[ring][bin].max(d.length());
     }
     for r in 1..rings {
