@@ -35,10 +35,11 @@ const KEEP_RATIO: f32 = 0.85;
 /// grid of this many segments and rings (about 3 cm between rings).
 const ANKLE_CLEARANCE: f32 = 0.1;
 const PROVISIONAL: (usize, usize) = (64, 28);
-/// Vertices around each ring of the fitted layer: about 3 cm apart at a dress's hem.
-const SEGMENTS: usize = 96;
-/// Heights at which the fitted profile is integrated to place the rings.
-const PROFILE_SAMPLES: usize = 256;
+/// Edge length of the fitted layer's triangles (m): the body mesh's mean edge, so the layer
+/// carries texture as finely as the body does.
+const EDGE: f32 = 0.015;
+/// Below the hem, the body's offsets are released over this height (m).
+const HEM_MARGIN: f32 = 0.08;
 
 /// Whether to add the layer: when the masks show a skirt, or never.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -158,7 +159,8 @@ fn outline_radii(skirt: &Skirt, carved: &[Option<f32>], centre: Vec3) -> Vec<f32
 
 /// Number of rings, from the waist, that keep their radius (see `RING_KEEPS`).
 fn skirt_rings(carved: &[Option<f32>], layout: &RingLayout) -> usize {
-    let n = layout.segments;
+    let n = layout.segments[0];
+    debug_assert!(layout.segments.iter().all(|&s| s == n), "the provisional grid is uniform");
     let ring = |r: usize| &carved[r * n..(r + 1) * n];
     let kept = |r: usize| {
         let count = if r == 0 {
@@ -175,31 +177,17 @@ fn skirt_rings(carved: &[Option<f32>], layout: &RingLayout) -> usize {
     (0..layout.rings.len()).take_while(|&r| kept(r)).count()
 }
 
-/// Rings spaced like the segments around them (spacing 2πr/N at radius r), so the layer's
-/// triangles are near-isotropic from the narrow waist to the wide hem. With one fixed spacing
-/// the hem's triangles came out 4.4 × 2.1 cm, and Tavatar's vertex Gaussians, sized by the
-/// shortest edge (Eq. 11), left holes between them. `radius(s)` is the mean radius at fraction
-/// `s` from waist to hem.
-fn isotropic_layout(length: f32, radius: impl Fn(f32) -> f32) -> RingLayout {
-    let step = |s: f32| length / (std::f32::consts::TAU * radius(s).max(1e-3) / SEGMENTS as f32);
-    let ds = 1.0 / PROFILE_SAMPLES as f32;
-    let mut cumulative = vec![0.0f32];
-    for i in 0..PROFILE_SAMPLES {
-        let mid = (i as f32 + 0.5) * ds;
-        cumulative.push(cumulative[i] + step(mid) * ds);
-    }
-    let total = cumulative[PROFILE_SAMPLES];
-    let gaps = total.round().max(1.0) as usize;
-    let rings = (0..=gaps)
-        .map(|j| {
-            let target = j as f32 / gaps as f32 * total;
-            let i = cumulative.partition_point(|&c| c < target).clamp(1, PROFILE_SAMPLES);
-            let (a, b) = (cumulative[i - 1], cumulative[i]);
-            let t = if b > a { (target - a) / (b - a) } else { 0.0 };
-            ((i - 1) as f32 + t.clamp(0.0, 1.0)) * ds
-        })
-        .collect();
-    RingLayout { segments: SEGMENTS, rings }
+/// Rings a triangle's height apart (`EDGE`·√3/2), each with as many vertices as keep `EDGE`
+/// between them at its radius, so the layer's triangles are near-equilateral and one size from
+/// the narrow waist to the wide hem. With 96 vertices on every ring the hem's edges were 2.5 cm
+/// against the body's 1 cm, and a dress's striped texture came out as dots in novel views.
+/// `radius(s)` is the mean radius at fraction `s` from waist to hem.
+fn even_layout(length: f32, radius: impl Fn(f32) -> f32) -> RingLayout {
+    let gaps = (length / (EDGE * 0.75f32.sqrt())).round().max(1.0) as usize;
+    let rings: Vec<f32> = (0..=gaps).map(|j| j as f32 / gaps as f32).collect();
+    let segments =
+        rings.iter().map(|&s| ((std::f32::consts::TAU * radius(s) / EDGE).round() as usize).max(3)).collect();
+    RingLayout::new(rings, segments)
 }
 
 /// Fits the layer to `views`' masks, or returns `None` when `mode` is off or the masks show the
@@ -238,12 +226,12 @@ pub fn fit_skirt(
     }
 
     // The provisional radii, read over the skirt's length, place the final rings.
-    let n = coarse.segments;
+    let n = coarse.segments[0];
     let profile: Vec<f32> = outline_radii(&provisional, &carved, centre)
         .chunks_exact(n)
         .map(|ring| ring.iter().sum::<f32>() / n as f32)
         .collect();
-    let layout = isotropic_layout(waist - hem, |s| {
+    let layout = even_layout(waist - hem, |s| {
         let x = (s * hem_s * PROVISIONAL.1 as f32).clamp(0.0, PROVISIONAL.1 as f32);
         let (i, t) = (x.floor() as usize, x.fract());
         let next = profile[(i + 1).min(PROVISIONAL.1)];
@@ -251,11 +239,10 @@ pub fn fit_skirt(
     });
     let mut skirt = build_skirt(&inside, centre, (waist, hem), (0.0, 0.0), &layout);
     let carved = carve_all(&hull, &skirt, centre);
-    let n = layout.segments;
-    for (k, p) in skirt.positions.iter_mut().enumerate() {
+    for ((k, p), ring) in skirt.positions.iter_mut().enumerate().zip(layout.ring_of_vertices()) {
         // Smooth along the ring ([1, 2, 1] / 4) over the pixel steps of the carving, and never
         // inside the body's own outline.
-        let (ring, seg) = (k / n, k % n);
+        let (n, seg) = (layout.segments[ring], k - layout.vertex(ring, 0));
         let d = horizontal(Vec3::from(*p), centre);
         let r0 = d.length();
         let at = |s: usize| carved[layout.vertex(ring, s)].unwrap_or(r0).max(r0);
@@ -266,19 +253,26 @@ pub fn fit_skirt(
 }
 
 impl SkirtLayer {
-    /// Whether the rest point lies under the layer: between waist and hem, and nearer the axis
-    /// through `centre` than the skirt's nearest vertex at that height and angle.
-    fn covers(&self, p: Vec3, centre: Vec3) -> bool {
-        if p.y >= self.waist || p.y <= self.hem {
-            return false;
+    /// How much of its offset the body's rest point `p` keeps: none under the layer (between
+    /// waist and hem, nearer the axis through `centre` than the skirt's nearest vertex), rising
+    /// linearly to all of it `HEM_MARGIN` below the hem. Training views see the body just below
+    /// the hem only past the hem's edge, and there its offsets fill the hem's edge rather than
+    /// fit the legs: ungated, the synthetic dress's inner thighs stretched 9 cm across the gap
+    /// between the legs, a curtain that the novel views from above and below showed.
+    fn offset_gate(&self, p: Vec3, centre: Vec3) -> f32 {
+        if p.y >= self.waist || p.y <= self.hem - HEM_MARGIN {
+            return 1.0;
         }
         let layout = &self.skirt.layout;
         let ring = layout.ring_at((self.waist - p.y) / (self.waist - self.hem));
         let d = horizontal(p, centre);
-        let turn = (d.z.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0);
-        let segment = (turn * layout.segments as f32).round() as usize;
-        let s = Vec3::from(self.skirt.positions[layout.vertex(ring, segment)]);
-        d.length() < horizontal(s, centre).length()
+        let s =
+            Vec3::from(self.skirt.positions[layout.nearest(ring, d.z.atan2(d.x) / std::f32::consts::TAU)]);
+        if d.length() >= horizontal(s, centre).length() {
+            1.0
+        } else {
+            ((self.hem - p.y) / HEM_MARGIN).max(0.0)
+        }
     }
 }
 
@@ -292,9 +286,7 @@ impl Canonical {
         let added = layer.skirt.positions.len();
         let centre = Vec3::from(self.joints[PELVIS]);
         for (gate, p) in self.offset_gate.iter_mut().zip(&self.vertices) {
-            if layer.covers(Vec3::from(*p), centre) {
-                *gate = 0.0;
-            }
+            *gate = gate.min(layer.offset_gate(Vec3::from(*p), centre));
         }
         self.offset_gate.extend(std::iter::repeat_n(1.0, added));
         if !self.posedirs.is_empty() {
