@@ -12,8 +12,10 @@
 //! the means; the breakdown is the first subject's.
 //!
 //! `--skirt auto|off` sets the skirt layer as `mannequin train --skirt` does (default auto).
+//! `--half-resolution-share F` trains the first share F of the iterations at half resolution
+//! (default 0.5; 0 trains all at full resolution, the baseline of that schedule).
 //!
-//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE]`
+//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE] [--half-resolution-share F]`
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -21,7 +23,8 @@ use std::time::{Duration, Instant};
 use burn::tensor::Device;
 use mannequin_avatar::evaluation::{AvatarScores, evaluate_avatar};
 use mannequin_avatar::{
-    Avatar, AvatarConfig, Canonical, Method, SkirtMode, Timings, TrainOptions, Trainer, View, load_views,
+    Avatar, AvatarConfig, Canonical, HALF_RESOLUTION_SHARE, Method, SkirtMode, Timings, TrainOptions,
+    Trainer, View, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
@@ -41,7 +44,8 @@ fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
         .unwrap_or(default)
 }
 
-/// Iterations timed for the breakdown, after 3 untimed warm-up iterations.
+/// Iterations timed for the breakdown: the last ones, at full resolution (the first ones run at
+/// half resolution), and never the first 3, which warm up.
 const TIMED: usize = 30;
 
 /// One synthetic subject: its mesh, training views, dataset folder and the bench's folder.
@@ -68,9 +72,10 @@ fn run(
     let mut trainer = Trainer::new(avatar, views.to_vec(), options).expect("trainer");
     let start = Instant::now();
     let mut sum = Timings::default();
+    let timed = iters.saturating_sub(TIMED).max(3)..iters;
     for i in 0..iters {
         let t = trainer.step().expect("step").timings;
-        if (3..3 + TIMED).contains(&i) {
+        if timed.contains(&i) {
             sum.skinning += t.skinning;
             sum.derivation += t.derivation;
             sum.render += t.render;
@@ -81,9 +86,9 @@ fn run(
     }
     let per_iter = start.elapsed().as_secs_f64() / iters as f64;
     if breakdown {
-        let n = TIMED as u32;
+        let n = timed.len().max(1) as u32;
         let render_backward = trainer.render_backward_time(5).expect("render backward");
-        println!("{name}: {gaussians} Gaussians at 540×540, mean of {TIMED} iterations (ms):");
+        println!("{name}: {gaussians} Gaussians at 540×540, mean of the last {n} iterations (ms):");
         println!("  skinning (offset field + LBS) {:8.2}", ms(sum.skinning / n));
         println!("  Gaussian derivation           {:8.2}", ms(sum.derivation / n));
         println!("  render forward                {:8.2}", ms(sum.render / n));
@@ -115,6 +120,7 @@ fn main() {
     let subjects: u64 = arg("--subjects", 1).max(1);
     let ablations = std::env::args().any(|a| a == "--ablations");
     let skirt_mode: SkirtMode = arg("--skirt", SkirtMode::Auto);
+    let half_resolution_share: f64 = arg("--half-resolution-share", HALF_RESOLUTION_SHARE);
     let dir = std::env::temp_dir().join(format!("mannequin-avatar-bench-{}", std::process::id()));
     let model = BodyModel::default_body();
     let mut table: Vec<(u64, AblationRow)> = Vec::new();
@@ -142,7 +148,8 @@ fn main() {
         full.antialiased = std::env::args().any(|a| a == "--antialiased");
         full.dilation = arg("--dilation", full.dilation);
         full.skirt_layer = skirt.is_some();
-        let train = || TrainOptions::new(Method::Tavatar, iters, subject);
+        let train =
+            || TrainOptions { half_resolution_share, ..TrainOptions::new(Method::Tavatar, iters, subject) };
         let (s, per_iter) = run("full", full.clone(), train(), &here, subject == seed);
         let g = &s.geometry;
         let chamfer = g.chamfer_cm.unwrap_or(f64::NAN);

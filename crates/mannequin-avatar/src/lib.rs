@@ -33,5 +33,5 @@ pub use config::{AVATAR_DILATION, AvatarConfig, Method};
 pub use error::AvatarError;
 pub use predict::{Prediction, predict, predict_split};
 pub use skirt_layer::SkirtMode;
-pub use trainer::{StepStats, Timings, TrainOptions, Trainer};
+pub use trainer::{HALF_RESOLUTION_SHARE, StepStats, Timings, TrainOptions, Trainer};
 pub use views::{View, frame_camera, load_views};

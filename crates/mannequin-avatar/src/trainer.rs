@@ -21,6 +21,11 @@ use crate::views::View;
 /// 6.4° (3DGS decays its position rate likewise, to 0.01).
 pub const FINAL_LR_FACTOR: f64 = 0.1;
 
+/// Share of the iterations, from the start, trained on views at half resolution: they cost
+/// about a third as much, and the first iterations fit shape and mean colour, which half the
+/// pixels show as well.
+pub const HALF_RESOLUTION_SHARE: f64 = 0.5;
+
 /// Loss weights and switches.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainOptions {
@@ -39,6 +44,8 @@ pub struct TrainOptions {
     /// Tavatar's learning rates decay exponentially to this fraction of their start by the last
     /// iteration (1 keeps them constant).
     pub final_lr_factor: f64,
+    /// Share of the iterations, from the start, on views at half resolution (0: none).
+    pub half_resolution_share: f64,
 }
 
 impl TrainOptions {
@@ -54,6 +61,7 @@ impl TrainOptions {
             lambda_equilateral: if ihuman { 0.0 } else { 0.01 },
             lambda_mask: 0.1,
             final_lr_factor: FINAL_LR_FACTOR,
+            half_resolution_share: HALF_RESOLUTION_SHARE,
         }
     }
 }
@@ -85,6 +93,8 @@ pub struct Trainer {
     pub iteration: usize,
     adam: Adam,
     views: Vec<View>,
+    /// `views` at half resolution, for the first iterations (see `half_resolution_share`).
+    halved: Vec<View>,
     topology: MeshTopology,
     /// 1 / (mean canonical edge length)²: makes the Laplacian term unit-free, so λ_m weighs it
     /// like the (unit-free) normal consistency whatever the mesh resolution.
@@ -138,7 +148,8 @@ impl Trainer {
         let adam = Adam::new(&avatar.params);
         let laplacian_scale = mean_edge_length(&avatar.canonical).max(1e-6).powi(-2);
         let base_lr = avatar.params.iter().map(|p| p.lr).collect();
-        Ok(Self { avatar, options, iteration: 0, adam, views, topology, laplacian_scale, base_lr })
+        let halved = views.iter().map(|v| v.halved().unwrap_or_else(|| v.clone())).collect();
+        Ok(Self { avatar, options, iteration: 0, adam, views, halved, topology, laplacian_scale, base_lr })
     }
 
     pub fn num_views(&self) -> usize {
@@ -195,7 +206,10 @@ impl Trainer {
         self.apply_schedule();
         let n = self.views.len();
         let (epoch, k) = (self.iteration / n, self.iteration % n);
-        let view = &self.views[epoch_order(self.options.seed, epoch, n)[k]];
+        let coarse =
+            (self.iteration as f64) < self.options.half_resolution_share * self.options.iterations as f64;
+        let views = if coarse { &self.halved } else { &self.views };
+        let view = &views[epoch_order(self.options.seed, epoch, n)[k]];
         let device = self.avatar.device().clone();
         let o = &self.options;
         let mut t = Timings::default();

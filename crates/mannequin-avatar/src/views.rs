@@ -64,6 +64,35 @@ impl View {
         let c = &self.crop;
         self.camera.crop(c.x, c.y, c.width, c.height)
     }
+
+    /// The crop at half resolution: each pixel the mean of a 2×2 block (an odd last row or
+    /// column dropped), mask included, so edges become fractional coverage as a render's alpha
+    /// is. Its camera is the crop's, downscaled, and its crop the whole of it. `None` when the
+    /// halved crop would be smaller than SSIM's window.
+    pub fn halved(&self) -> Option<View> {
+        let (w, h) = (self.crop.width / 2, self.crop.height / 2);
+        if w < MIN_CROP || h < MIN_CROP {
+            return None;
+        }
+        let (stride, n) = (self.crop.width, self.crop.width * self.crop.height);
+        let block = |plane: &[f32], x: usize, y: usize| {
+            let at = |dx: usize, dy: usize| plane[(2 * y + dy) * stride + 2 * x + dx];
+            0.25 * (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1))
+        };
+        let half = |planes: &[f32]| -> Vec<f32> {
+            planes
+                .chunks_exact(n)
+                .flat_map(|plane| (0..w * h).map(move |q| block(plane, q % w, q / w)))
+                .collect()
+        };
+        Some(View {
+            camera: self.crop_camera().downscale(2),
+            crop: Crop { x: 0, y: 0, width: w, height: h },
+            targets: half(&self.targets),
+            mask: half(&self.mask),
+            ..self.clone()
+        })
+    }
 }
 
 /// The mask's bounding box grown by the margin, clamped to the image, at least `MIN_CROP` wide.
@@ -131,4 +160,45 @@ pub fn load_views(
         progress(i + 1, split.frames.len());
     }
     Ok(views)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn halving_averages_blocks_and_keeps_the_camera_on_them() {
+        let camera =
+            mannequin_splat::Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 0.8, 64, 48);
+        // A 25 × 23 crop at (9, 7): the halved view is 12 × 11, dropping the odd last column and
+        // row. Channel c of pixel (x, y) holds 1000c + 100y + x.
+        let crop = Crop { x: 9, y: 7, width: 25, height: 23 };
+        let n = crop.width * crop.height;
+        let value = |c: usize, x: usize, y: usize| (1000 * c + 100 * y + x) as f32;
+        let targets = (0..6 * n).map(|i| value(i / n, i % n % crop.width, i % n / crop.width)).collect();
+        let mask = (0..n).map(|i| f32::from(u8::from(i % crop.width < 13))).collect();
+        let view = View { frame: 0, camera, pose: vec![0.0; 72], transl: [0.0; 3], crop, targets, mask };
+        let half = view.halved().expect("large enough");
+        assert_eq!((half.crop.x, half.crop.y, half.crop.width, half.crop.height), (0, 0, 12, 11));
+        assert_eq!(half.target_channels(), 6);
+        let m = 12 * 11;
+        for (c, x, y) in [(0, 0, 0), (2, 5, 3), (5, 11, 10)] {
+            // The mean of x over {2x, 2x + 1} is 2x + ½, likewise for y.
+            let expected = 1000.0 * c as f32 + 100.0 * (2 * y) as f32 + 50.0 + (2 * x) as f32 + 0.5;
+            assert_eq!(half.targets[c * m + y * 12 + x], expected);
+        }
+        // Columns 0–12 of the crop are masked: block 6 holds columns 12 and 13, half covered.
+        assert_eq!(half.mask[6], 0.5);
+        assert_eq!(half.mask[5], 1.0);
+        assert_eq!(half.mask[7], 0.0);
+        // A world point lands at half its crop coordinates.
+        let p = DVec3::new(0.1, -0.05, 0.2);
+        let [u, v] = view.crop_camera().project(view.crop_camera().world_to_camera(p));
+        let [hu, hv] = half.crop_camera().project(half.crop_camera().world_to_camera(p));
+        assert!((hu - u / 2.0).abs() < 1e-9 && (hv - v / 2.0).abs() < 1e-9, "({u}, {v}) → ({hu}, {hv})");
+        // Too small to halve: SSIM's window would not fit.
+        let small = View { crop: Crop { width: 21, height: 30, ..crop }, ..view };
+        assert!(small.halved().is_none());
+    }
 }
