@@ -135,14 +135,9 @@ fn main() {
         let views = load_views(&dataset, &split, |_, _| {}).expect("views");
         let (canonical, skirt) =
             Canonical::for_subject(&model, &split.poses.betas, 0, &views, skirt_mode).expect("canonical");
-        if let Some(s) = &skirt {
-            println!(
-                "  skirt layer: {} vertices, hem {:.0} cm below the waist",
-                s.skirt.positions.len(),
-                100.0 * (s.waist - s.hem)
-            );
+        if let Some(layer) = &skirt {
+            println!("  skirt: {layer}");
         }
-
         let here = Subject { canonical: &canonical, views: &views, data: &data, dir: &dir };
         let mut full = AvatarConfig::new(Method::Tavatar, subject);
         full.antialiased = std::env::args().any(|a| a == "--antialiased");

@@ -122,12 +122,8 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
     }
     let (canonical, skirt) =
         Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, args.skirt)?;
-    if let Some(s) = &skirt {
-        tracing::info!(
-            "the masks show a skirt: adding a layer of {} vertices from the waist to {:.0} cm below it (--skirt off trains without)",
-            s.skirt.positions.len(),
-            100.0 * (s.waist - s.hem)
-        );
+    if let Some(layer) = &skirt {
+        tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
     }
     let mut config = avatar_config(args);
     config.skirt_layer = skirt.is_some();
