@@ -1,15 +1,21 @@
-//! The passes over host slices for fixed widths `I → H → H → O` (compile-time, so each row's
-//! activations stay in vector registers). Rows are split into [`CHUNKS`] fixed chunks run in
-//! parallel; each chunk sums its own weight gradients, and the chunks are added in order, so
-//! the result does not depend on the thread count.
+//! The passes over host slices for fixed widths `I → H → H → O` (compile-time, so every product
+//! is a small matrix product the compiler unrolls and vectorises). Rows go through in tiles of
+//! [`TILE`]: each layer is one tile × weights product, and each weight gradient one transposed
+//! tile × gradient tile product, all in L1. Rows are split into [`CHUNKS`] fixed chunks run in
+//! parallel; each chunk sums its own weight gradients, and the chunks are added in order, so the
+//! result does not depend on the thread count.
 
 use rayon::prelude::*;
 
 /// Fixed number of row chunks (see the module doc).
 const CHUNKS: usize = 16;
 
-/// Rows whose weight-gradient outer products are summed in registers before touching memory.
-const BLOCK: usize = 8;
+/// Rows per tile: its activations (`TILE × H` floats per layer) stay in L1.
+const TILE: usize = 32;
+
+/// Output rows per register block: each loaded row of the right factor feeds `MR` independent
+/// accumulator rows, so the fused multiply-adds are not serialised on one row's latency.
+const MR: usize = 4;
 
 /// The network's parameters, row-major: `w0 [I, H]`, `b0 [H]`, `w1 [H, H]`, `b1 [H]`,
 /// `w2 [H, O]`, `b2 [O]`.
@@ -18,94 +24,146 @@ pub struct Weights<'a> {
     pub b: [&'a [f32]; 3],
 }
 
-/// `out = b + x·W` for one row (`W` row-major `[N_IN, N_OUT]`).
+/// A row-major `[R, C]` slice as rows.
+fn rows<const R: usize, const C: usize>(values: &[f32]) -> &[[f32; C]; R] {
+    values.as_chunks::<C>().0.try_into().expect("matrix shape")
+}
+
+fn rows_mut<const R: usize, const C: usize>(values: &mut [f32]) -> &mut [[f32; C]; R] {
+    values.as_chunks_mut::<C>().0.try_into().expect("matrix shape")
+}
+
+/// `c += a·b` (`a [M, K]` given by `a(row, k)`, `b [K, N]`, `c [M, N]`), `B` rows of `c` at a
+/// time (`M` is a multiple of `B`); `a` is an accessor so a transposed tile needs no copy.
 #[inline(always)]
-fn affine<const N_IN: usize, const N_OUT: usize>(x: &[f32; N_IN], w: &[f32], b: &[f32]) -> [f32; N_OUT] {
-    let mut out: [f32; N_OUT] = b.try_into().expect("bias width");
-    for (xi, row) in x.iter().zip(w.chunks_exact(N_OUT)) {
-        for (o, wij) in out.iter_mut().zip(row) {
-            *o += xi * wij;
+fn mul_add<const B: usize, const M: usize, const K: usize, const N: usize>(
+    c: &mut [[f32; N]; M],
+    a: impl Fn(usize, usize) -> f32,
+    b: &[[f32; N]; K],
+) {
+    for (block, c) in c.as_chunks_mut::<B>().0.iter_mut().enumerate() {
+        let mut acc = *c;
+        for (k, b) in b.iter().enumerate() {
+            for (r, acc) in acc.iter_mut().enumerate() {
+                let s = a(block * B + r, k);
+                acc.iter_mut().zip(b).for_each(|(x, b)| *x = s.mul_add(*b, *x));
+            }
         }
+        *c = acc;
     }
-    out
 }
 
-fn relu<const N: usize>(mut h: [f32; N]) -> [f32; N] {
-    h.iter_mut().for_each(|x| *x = x.max(0.0));
-    h
-}
-
-/// The hidden activations of one row (after the ReLUs).
+/// `h = max(0, bias + a·w)` for a tile.
 #[inline(always)]
-fn hidden<const I: usize, const H: usize>(x: &[f32; I], p: &Weights) -> ([f32; H], [f32; H]) {
-    let h1 = relu(affine::<I, H>(x, p.w[0], p.b[0]));
-    let h2 = relu(affine::<H, H>(&h1, p.w[1], p.b[1]));
-    (h1, h2)
+fn relu_layer<const K: usize, const N: usize>(
+    h: &mut [[f32; N]; TILE],
+    a: &[[f32; K]; TILE],
+    w: &[[f32; N]; K],
+    bias: &[f32],
+) {
+    h.fill(bias.try_into().expect("bias width"));
+    mul_add::<MR, TILE, K, N>(h, |r, k| a[r][k], w);
+    h.as_flattened_mut().iter_mut().for_each(|x| *x = x.max(0.0));
 }
 
-fn row<const N: usize>(values: &[f32], r: usize) -> &[f32; N] {
-    values[r * N..][..N].try_into().expect("row width")
+/// `bias + h·W` for a layer of few outputs, from `wt = Wᵀ`: one dot product per output, summed
+/// in 16 lanes so that it vectorises.
+fn narrow_layer<const K: usize, const N: usize>(h: &[f32; K], wt: &[[f32; K]; N], bias: &[f32]) -> [f32; N] {
+    std::array::from_fn(|o| {
+        let mut lanes = [0.0f32; 16];
+        for (h, w) in h.as_chunks::<16>().0.iter().zip(wt[o].as_chunks::<16>().0) {
+            lanes.iter_mut().zip(h.iter().zip(w)).for_each(|(l, (h, w))| *l = h.mul_add(*w, *l));
+        }
+        bias[o] + lanes.iter().sum::<f32>()
+    })
+}
+
+/// Zeroes the gradient where the layer's output `h` was clipped by its ReLU.
+fn mask<const N: usize>(g: &mut [[f32; N]; TILE], h: &[[f32; N]; TILE]) {
+    let h = h.as_flattened();
+    g.as_flattened_mut().iter_mut().zip(h).for_each(|(g, h)| *g = if *h > 0.0 { *g } else { 0.0 });
+}
+
+fn transpose<const M: usize, const N: usize>(a: &[[f32; N]; M]) -> [[f32; M]; N] {
+    std::array::from_fn(|j| std::array::from_fn(|i| a[i][j]))
+}
+
+/// Loads rows `start..start + TILE` of a `[n, C]` slice, zero past its end; returns how many
+/// rows were present.
+fn load<const C: usize>(t: &mut [[f32; C]; TILE], values: &[f32], start: usize) -> usize {
+    let present = &values.as_chunks::<C>().0[start..];
+    let m = present.len().min(TILE);
+    t[..m].copy_from_slice(&present[..m]);
+    t[m..].fill([0.0; C]);
+    m
+}
+
+/// One tile's activations and gradients, reused across a chunk's tiles.
+struct Tile<const I: usize, const H: usize, const O: usize> {
+    x: [[f32; I]; TILE],
+    h1: [[f32; H]; TILE],
+    h2: [[f32; H]; TILE],
+    g0: [[f32; H]; TILE],
+    g1: [[f32; H]; TILE],
+    g2: [[f32; O]; TILE],
+    dx: [[f32; I]; TILE],
+}
+
+impl<const I: usize, const H: usize, const O: usize> Tile<I, H, O> {
+    fn new() -> Box<Self> {
+        Box::new(Tile {
+            x: [[0.0; I]; TILE],
+            h1: [[0.0; H]; TILE],
+            h2: [[0.0; H]; TILE],
+            g0: [[0.0; H]; TILE],
+            g1: [[0.0; H]; TILE],
+            g2: [[0.0; O]; TILE],
+            dx: [[0.0; I]; TILE],
+        })
+    }
+
+    /// Loads the inputs from row `start` and computes the hidden activations (after the ReLUs);
+    /// returns how many rows were present.
+    fn hidden(&mut self, x: &[f32], start: usize, p: &Weights) -> usize {
+        let m = load(&mut self.x, x, start);
+        relu_layer(&mut self.h1, &self.x, rows::<I, H>(p.w[0]), p.b[0]);
+        relu_layer(&mut self.h2, &self.h1, rows::<H, H>(p.w[1]), p.b[1]);
+        m
+    }
+}
+
+/// The rows of `n` that chunk `c` covers.
+fn chunk_rows(n: usize, c: usize) -> std::ops::Range<usize> {
+    let per_chunk = n.div_ceil(CHUNKS).max(1);
+    (c * per_chunk).min(n)..((c + 1) * per_chunk).min(n)
 }
 
 pub fn forward<const I: usize, const H: usize, const O: usize>(x: &[f32], p: &Weights) -> Vec<f32> {
     let n = x.len() / I;
-    let mut out = vec![0.0f32; n * O];
-    out.par_chunks_mut(O * n.div_ceil(CHUNKS).max(1)).enumerate().for_each(|(c, out)| {
-        let start = c * n.div_ceil(CHUNKS).max(1);
-        for (k, o) in out.chunks_exact_mut(O).enumerate() {
-            let (_, h2) = hidden::<I, H>(row::<I>(x, start + k), p);
-            o.copy_from_slice(&affine::<H, O>(&h2, p.w[2], p.b[2]));
-        }
-    });
-    out
+    let wt2: [[f32; H]; O] = transpose(rows::<H, O>(p.w[2]));
+    let chunks: Vec<Vec<f32>> = (0..CHUNKS)
+        .into_par_iter()
+        .map(|c| {
+            let rows_c = chunk_rows(n, c);
+            let mut out = Vec::with_capacity(rows_c.len() * O);
+            let mut t = Tile::<I, H, O>::new();
+            for start in rows_c.clone().step_by(TILE) {
+                let m = t.hidden(&x[..rows_c.end * I], start, p);
+                t.h2[..m].iter().for_each(|h| out.extend(narrow_layer(h, &wt2, p.b[2])));
+            }
+            out
+        })
+        .collect();
+    chunks.concat()
 }
 
-/// `dW += Σ_r a_r ⊗ g_r` over a block of rows (`a` `[B, N_A]`, `g` `[B, N_G]`), one weight row
-/// at a time so its partial sum stays in registers.
-#[inline(always)]
-fn outer_add<const N_A: usize, const N_G: usize>(dw: &mut [f32], a: &[[f32; N_A]], g: &[[f32; N_G]]) {
-    for (i, dw_row) in dw.chunks_exact_mut(N_G).enumerate() {
-        let mut acc = [0.0f32; N_G];
-        for (ar, gr) in a.iter().zip(g) {
-            let s = ar[i];
-            for (x, gj) in acc.iter_mut().zip(gr) {
-                *x += s * gj;
-            }
-        }
-        for (d, x) in dw_row.iter_mut().zip(acc) {
-            *d += x;
-        }
-    }
-}
+/// Gradients of one chunk: `(dx rows, [dw0, dw1, dw2ᵀ], [db0, db1, db2])`.
+type ChunkGrads = (Vec<f32>, [Vec<f32>; 3], [Vec<f32>; 3]);
 
 /// `db += Σ_r g_r`.
-fn add_rows<const N: usize>(db: &mut [f32], g: &[[f32; N]]) {
+fn add_rows<const N: usize>(db: &mut [f32], g: &[[f32; N]; TILE]) {
     g.iter().for_each(|g| db.iter_mut().zip(g).for_each(|(d, x)| *d += x));
 }
-
-/// `g·Wᵀ` for one row, from `wt = Wᵀ` (`[N_OUT, N_IN]`, so the sum runs over contiguous rows
-/// and vectorises), zeroed where the layer's input was clipped by its ReLU (`h = 0`).
-#[inline(always)]
-fn back<const N_IN: usize, const N_OUT: usize>(
-    g: &[f32; N_OUT],
-    wt: &[f32],
-    h: Option<&[f32; N_IN]>,
-) -> [f32; N_IN] {
-    let mut out = affine::<N_OUT, N_IN>(g, wt, &[0.0; N_IN]);
-    if let Some(h) = h {
-        out.iter_mut().zip(h).for_each(|(o, h)| *o = if *h > 0.0 { *o } else { 0.0 });
-    }
-    out
-}
-
-/// `Wᵀ` of a row-major `[rows, cols]` matrix.
-fn transpose(w: &[f32], cols: usize) -> Vec<f32> {
-    let rows = w.len() / cols;
-    (0..cols).flat_map(|j| (0..rows).map(move |i| w[i * cols + j])).collect()
-}
-
-/// Gradients of one chunk: `(dx rows, [dw0, dw1, dw2], [db0, db1, db2])`.
-type ChunkGrads = (Vec<f32>, [Vec<f32>; 3], [Vec<f32>; 3]);
 
 /// `(dx [N, I], [dw0, dw1, dw2], [db0, db1, db2])` given `grad` `[N, O]` of the outputs; the
 /// activations are recomputed (cheaper than storing them).
@@ -115,42 +173,43 @@ pub fn backward<const I: usize, const H: usize, const O: usize>(
     p: &Weights,
 ) -> (Vec<f32>, [Vec<f32>; 3], [Vec<f32>; 3]) {
     let n = x.len() / I;
-    let per_chunk = n.div_ceil(CHUNKS).max(1);
-    let wt = [transpose(p.w[0], H), transpose(p.w[1], H), transpose(p.w[2], O)];
+    let wt0: [[f32; I]; H] = transpose(rows::<I, H>(p.w[0]));
+    let wt1: [[f32; H]; H] = transpose(rows::<H, H>(p.w[1]));
+    let wt2: [[f32; H]; O] = transpose(rows::<H, O>(p.w[2]));
     let chunks: Vec<ChunkGrads> = (0..CHUNKS)
         .into_par_iter()
         .map(|c| {
-            let rows = (c * per_chunk).min(n)..((c + 1) * per_chunk).min(n);
-            let mut dx = Vec::with_capacity(rows.len() * I);
-            let mut dw = [vec![0.0f32; I * H], vec![0.0f32; H * H], vec![0.0f32; H * O]];
+            let rows_c = chunk_rows(n, c);
+            let mut dx = Vec::with_capacity(rows_c.len() * I);
+            let mut dw = [vec![0.0f32; I * H], vec![0.0f32; H * H], vec![0.0f32; O * H]];
             let mut db = [vec![0.0f32; H], vec![0.0f32; H], vec![0.0f32; O]];
-            let mut start = rows.start;
-            while start < rows.end {
-                let end = (start + BLOCK).min(rows.end);
-                let m = end - start;
-                let (mut xs, mut h1s, mut h2s) = ([[0.0; I]; BLOCK], [[0.0; H]; BLOCK], [[0.0; H]; BLOCK]);
-                let (mut g0s, mut g1s, mut g2s) = ([[0.0; H]; BLOCK], [[0.0; H]; BLOCK], [[0.0; O]; BLOCK]);
-                for (k, r) in (start..end).enumerate() {
-                    xs[k] = *row::<I>(x, r);
-                    (h1s[k], h2s[k]) = hidden::<I, H>(&xs[k], p);
-                    g2s[k] = *row::<O>(grad, r);
-                    g1s[k] = back::<H, O>(&g2s[k], &wt[2], Some(&h2s[k]));
-                    g0s[k] = back::<H, H>(&g1s[k], &wt[1], Some(&h1s[k]));
-                    dx.extend_from_slice(&back::<I, H>(&g0s[k], &wt[0], None));
-                }
-                outer_add::<I, H>(&mut dw[0], &xs[..m], &g0s[..m]);
-                outer_add::<H, H>(&mut dw[1], &h1s[..m], &g1s[..m]);
-                outer_add::<H, O>(&mut dw[2], &h2s[..m], &g2s[..m]);
-                add_rows(&mut db[0], &g0s[..m]);
-                add_rows(&mut db[1], &g1s[..m]);
-                add_rows(&mut db[2], &g2s[..m]);
-                start = end;
+            let mut t = Tile::<I, H, O>::new();
+            for start in rows_c.clone().step_by(TILE) {
+                // Rows past the chunk's end have zero output gradient, so they add nothing.
+                let m = t.hidden(&x[..rows_c.end * I], start, p);
+                load(&mut t.g2, &grad[..rows_c.end * O], start);
+                let Tile { x, h1, h2, g0, g1, g2, dx: dx_t } = &mut *t;
+                g1.fill([0.0; H]);
+                mul_add::<MR, TILE, O, H>(g1, |r, k| g2[r][k], &wt2);
+                mask(g1, h2);
+                g0.fill([0.0; H]);
+                mul_add::<MR, TILE, H, H>(g0, |r, k| g1[r][k], &wt1);
+                mask(g0, h1);
+                dx_t.fill([0.0; I]);
+                mul_add::<MR, TILE, H, I>(dx_t, |r, k| g0[r][k], &wt0);
+                dx.extend_from_slice(dx_t[..m].as_flattened());
+                mul_add::<MR, I, TILE, H>(rows_mut(&mut dw[0]), |i, r| x[r][i], g0);
+                mul_add::<MR, H, TILE, H>(rows_mut(&mut dw[1]), |i, r| h1[r][i], g1);
+                mul_add::<O, O, TILE, H>(rows_mut(&mut dw[2]), |o, r| g2[r][o], h2);
+                add_rows(&mut db[0], g0);
+                add_rows(&mut db[1], g1);
+                add_rows(&mut db[2], g2);
             }
             (dx, dw, db)
         })
         .collect();
     let mut dx = Vec::with_capacity(n * I);
-    let mut dw = [vec![0.0f32; I * H], vec![0.0f32; H * H], vec![0.0f32; H * O]];
+    let mut dw = [vec![0.0f32; I * H], vec![0.0f32; H * H], vec![0.0f32; O * H]];
     let mut db = [vec![0.0f32; H], vec![0.0f32; H], vec![0.0f32; O]];
     for (cdx, cdw, cdb) in chunks {
         dx.extend(cdx);
@@ -158,5 +217,7 @@ pub fn backward<const I: usize, const H: usize, const O: usize>(
             total.iter_mut().zip(part).for_each(|(t, p)| *t += p);
         }
     }
-    (dx, dw, db)
+    let dw2 = transpose(rows::<O, H>(&dw[2])).as_flattened().to_vec();
+    let [dw0, dw1, _] = dw;
+    (dx, [dw0, dw1, dw2], db)
 }

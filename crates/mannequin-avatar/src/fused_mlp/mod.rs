@@ -1,8 +1,9 @@
 //! The MLP head `I → H → H → O` (two hidden ReLU layers) as one differentiable op with a
 //! hand-written backward on Flex (CPU), for the widths the avatar uses. Through Burn's ops each
 //! layer is a gemm plus bias, ReLU and their backward passes, and the weight gradients (64×64
-//! outputs over 13k rows) hardly parallelise; here each row's activations stay in registers and
-//! the weight gradients are summed per row chunk ([`crate::host_ops`] says where it runs).
+//! outputs over 13k rows) hardly parallelise; here rows go through in L1-sized tiles whose
+//! products are register-blocked, and the weight gradients are summed per row chunk
+//! ([`crate::host_ops`] says where it runs).
 
 mod autodiff;
 mod flex;
