@@ -14,7 +14,7 @@ impl BindingBackend for Flex {
     fn tavatar_bind_forward(vertices: FloatTensor<Self>, config: BindConfig) -> FloatTensor<Self> {
         let v = contiguous(vertices);
         let out = host::forward(v.as_slice::<f32>().expect(LAYOUT), &config);
-        FlexTensor::from_data(TensorData::new(out, [config.num_gaussians(), PACKED]))
+        FlexTensor::from_data(TensorData::new(out, [config.num_gaussians() * PACKED]))
     }
 
     fn tavatar_bind_backward(

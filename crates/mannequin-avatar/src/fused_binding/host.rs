@@ -3,9 +3,11 @@
 //! ~100 whole-tensor ops, each allocating. Scatters onto vertices run in a fixed sequential order,
 //! so gradients are bit-identical from run to run whatever the thread count.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
-use super::{BindConfig, PACKED, Topology};
+use super::{BindConfig, PACKED, PLANES, Topology};
 use crate::mesh_gaussians::{FACE_SCALE, NORM_EPS, NORMAL_SCALE, VERTEX_SCALE};
 
 type V3 = [f32; 3];
@@ -45,21 +47,55 @@ fn point(v: &[f32], i: u32) -> V3 {
     [v[i], v[i + 1], v[i + 2]]
 }
 
-/// Writes a packed row: mean, frame (row-major, columns t1, t2, n), disk scales, normal.
-fn write_row(row: &mut [f32], mean: V3, t1: V3, t2: V3, n: V3, in_plane: f32) {
-    row[0..3].copy_from_slice(&mean);
+/// One Gaussian's slots in the four [`PLANES`].
+type Row<'a> = [&'a mut [f32]; 4];
+
+/// One Gaussian's gradient in the four [`PLANES`].
+type RowGrad<'a> = [&'a [f32]; 4];
+
+/// Writes a row: mean, frame (row-major, columns t1, t2, n), disk scales, normal.
+fn write_row(row: Row, mean: V3, t1: V3, t2: V3, n: V3, in_plane: f32) {
+    let [m, frame, s, normal] = row;
+    m.copy_from_slice(&mean);
     for r in 0..3 {
-        row[3 + 3 * r..6 + 3 * r].copy_from_slice(&[t1[r], t2[r], n[r]]);
+        frame[3 * r..3 * r + 3].copy_from_slice(&[t1[r], t2[r], n[r]]);
     }
-    row[12..15].copy_from_slice(&[in_plane, in_plane, NORMAL_SCALE as f32]);
-    row[15..18].copy_from_slice(&n);
+    s.copy_from_slice(&[in_plane, in_plane, NORMAL_SCALE as f32]);
+    normal.copy_from_slice(&n);
 }
 
-/// A packed row's gradient as (mean, t1, t2, n, in-plane scale); the normal output adds to n.
-fn read_row(g: &[f32]) -> (V3, V3, V3, V3, f32) {
-    let column = |k: usize| [g[3 + k], g[6 + k], g[9 + k]];
-    let n = add(column(2), [g[15], g[16], g[17]]);
-    ([g[0], g[1], g[2]], column(0), column(1), n, g[12] + g[13])
+/// A row's gradient as (mean, t1, t2, n, in-plane scale); the normal output adds to n.
+fn read_row(g: RowGrad) -> (V3, V3, V3, V3, f32) {
+    let [m, frame, s, normal] = g;
+    let column = |k: usize| [frame[k], frame[3 + k], frame[6 + k]];
+    let n = add(column(2), [normal[0], normal[1], normal[2]]);
+    ([m[0], m[1], m[2]], column(0), column(1), n, s[0] + s[1])
+}
+
+/// Rows `range` of the planes of `out` (`g` Gaussians), in parallel.
+fn rows_mut(out: &mut [f32], g: usize, range: Range<usize>) -> impl IndexedParallelIterator<Item = Row<'_>> {
+    let mut rest = out;
+    let [m, f, s, n] = PLANES.map(|w| {
+        let (plane, tail) = std::mem::take(&mut rest).split_at_mut(w * g);
+        rest = tail;
+        &mut plane[w * range.start..w * range.end]
+    });
+    let [wm, wf, ws, wn] = PLANES;
+    m.par_chunks_mut(wm)
+        .zip(f.par_chunks_mut(wf))
+        .zip(s.par_chunks_mut(ws))
+        .zip(n.par_chunks_mut(wn))
+        .map(|(((m, f), s), n)| [m, f, s, n])
+}
+
+/// Row `k`'s gradient in the planes of `grad` (`g` Gaussians).
+fn row_grad(grad: &[f32], g: usize, k: usize) -> RowGrad<'_> {
+    let mut start = 0;
+    PLANES.map(|w| {
+        let row = &grad[start + w * k..start + w * (k + 1)];
+        start += w * g;
+        row
+    })
 }
 
 /// What Eqs. 5–8 read of one face.
@@ -100,23 +136,24 @@ impl Face {
         scale(add(scale(self.e_ab, lb), scale(self.e_ac, lc)), 1.0 / self.perimeter)
     }
 
-    /// Eqs. 5–8 into a packed row.
-    fn write(&self, row: &mut [f32]) {
+    /// Eqs. 5–8 into a row.
+    fn write(&self, row: Row) {
         let n = scale(self.cross, 1.0 / self.double_area);
         let t1 = scale(self.e_ab, 1.0 / self.lengths[2]);
         let in_plane = FACE_SCALE as f32 * self.double_area / self.perimeter;
         write_row(row, add(self.corners[0], self.incenter_from_a()), t1, cross(n, t1), n, in_plane);
     }
 
-    /// Gradients of the three corners given the packed row's gradient `g` and an extra gradient
-    /// `g_cross` on the face's cross product (from the vertex normals).
-    fn vjp(&self, g: &[f32], g_cross: V3) -> [V3; 3] {
+    /// Gradients of the three corners given the row's gradient `g` (none without face
+    /// Gaussians) and an extra gradient `g_cross` on the face's cross product (from the vertex
+    /// normals).
+    fn vjp(&self, g: Option<RowGrad>, g_cross: V3) -> [V3; 3] {
         let [_, b, c] = self.corners;
         let [la, lb, lc] = self.lengths;
         let (p, a2) = (self.perimeter, self.double_area);
         let n = scale(self.cross, 1.0 / a2);
         let t1 = scale(self.e_ab, 1.0 / lc);
-        let (g_mean, mut g_t1, g_t2, mut g_n, g_s) = read_row(g);
+        let (g_mean, mut g_t1, g_t2, mut g_n, g_s) = g.map(read_row).unwrap_or_default();
         // t2 = n × t1.
         g_n = add(g_n, cross(t1, g_t2));
         g_t1 = add(g_t1, cross(g_t2, n));
@@ -207,14 +244,14 @@ impl Vertex {
         (n, t1, cross(n, t1))
     }
 
-    fn write(&self, row: &mut [f32]) {
+    fn write(&self, row: Row) {
         let (n, t1, t2) = self.frame();
         write_row(row, self.position, t1, t2, n, VERTEX_SCALE as f32 * self.edge_length);
     }
 
-    /// Gradients of (the summed face crosses, the vertex, the shortest edge) given the packed
-    /// row's gradient.
-    fn vjp(&self, g: &[f32]) -> (V3, V3, V3) {
+    /// Gradients of (the summed face crosses, the vertex, the shortest edge) given the row's
+    /// gradient.
+    fn vjp(&self, g: RowGrad) -> (V3, V3, V3) {
         let (n, t1, _) = self.frame();
         let (g_mean, g_t1, g_t2, g_n, g_s) = read_row(g);
         let g_n = add(g_n, cross(t1, g_t2));
@@ -236,17 +273,18 @@ fn vertices_of(v: &[f32], topology: &Topology, sums: &[V3]) -> Vec<Vertex> {
     (0..topology.num_vertices).into_par_iter().map(|i| Vertex::new(v, topology, sums, i)).collect()
 }
 
-/// Packed Gaussians `[G, PACKED]` of vertices `[V · 3]`: face Gaussians first, then vertex ones.
+/// Gaussians `[G · PACKED]` of vertices `[V · 3]` as [`PLANES`]: face Gaussians first, then
+/// vertex ones.
 pub(crate) fn forward(v: &[f32], config: &BindConfig) -> Vec<f32> {
     let t = &config.topology;
     let faces = faces_of(v, t);
-    let mut out = vec![0.0; PACKED * config.num_gaussians()];
-    let split = if config.face_gaussians { PACKED * faces.len() } else { 0 };
-    let (face_rows, vertex_rows) = out.split_at_mut(split);
-    face_rows.par_chunks_mut(PACKED).zip(&faces).for_each(|(row, face)| face.write(row));
+    let g = config.num_gaussians();
+    let mut out = vec![0.0; PACKED * g];
+    let split = if config.face_gaussians { faces.len() } else { 0 };
+    rows_mut(&mut out, g, 0..split).zip(&faces).for_each(|(row, face)| face.write(row));
     if config.vertex_gaussians {
         let vertices = vertices_of(v, t, &cross_sums(t, &faces));
-        vertex_rows.par_chunks_mut(PACKED).zip(&vertices).for_each(|(row, vertex)| vertex.write(row));
+        rows_mut(&mut out, g, split..g).zip(&vertices).for_each(|(row, vertex)| vertex.write(row));
     }
     out
 }
@@ -255,35 +293,34 @@ pub(crate) fn forward(v: &[f32], config: &BindConfig) -> Vec<f32> {
 pub(crate) fn backward(v: &[f32], grad: &[f32], config: &BindConfig) -> Vec<f32> {
     let t = &config.topology;
     let faces = faces_of(v, t);
+    let g = config.num_gaussians();
     let mut d = vec![0.0f32; 3 * t.num_vertices];
     let mut add_to = |i: u32, g: V3| {
         for k in 0..3 {
             d[3 * i as usize + k] += g[k];
         }
     };
-    let (face_grad, vertex_grad) =
-        grad.split_at(if config.face_gaussians { PACKED * faces.len() } else { 0 });
+    let split = if config.face_gaussians { faces.len() } else { 0 };
     // Vertex Gaussians first: their normals' gradient lands on the adjacent faces' crosses.
     let mut g_sums = vec![[0.0; 3]; t.num_vertices];
     if config.vertex_gaussians {
         let vertices = vertices_of(v, t, &cross_sums(t, &faces));
         let grads: Vec<(V3, V3, V3)> =
-            vertices.par_iter().zip(vertex_grad.par_chunks(PACKED)).map(|(x, g)| x.vjp(g)).collect();
+            vertices.par_iter().enumerate().map(|(i, x)| x.vjp(row_grad(grad, g, split + i))).collect();
         for (i, (x, (g_sum, g_mean, g_edge))) in vertices.iter().zip(grads).enumerate() {
             g_sums[i] = g_sum;
             add_to(i as u32, sub(g_mean, g_edge));
             add_to(x.nearest, g_edge);
         }
     }
-    let zero = [0.0; PACKED];
     let corner_grads: Vec<[V3; 3]> = faces
         .par_iter()
         .zip(&t.faces)
         .enumerate()
         .map(|(k, (face, f))| {
-            let g = if config.face_gaussians { &face_grad[PACKED * k..PACKED * (k + 1)] } else { &zero };
+            let row = config.face_gaussians.then(|| row_grad(grad, g, k));
             let g_cross = f.iter().fold([0.0; 3], |s, &i| add(s, g_sums[i as usize]));
-            face.vjp(g, g_cross)
+            face.vjp(row, g_cross)
         })
         .collect();
     for (f, g) in t.faces.iter().zip(corner_grads) {

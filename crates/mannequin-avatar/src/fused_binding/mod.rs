@@ -16,8 +16,14 @@ use mannequin_mesh::adjacency::one_rings;
 
 use crate::mesh_gaussians::GaussianGeometry;
 
-/// Values per Gaussian in the op's output: mean (3), frame (9, row-major with columns t1, t2, n),
-/// scales (3) and the normal (3, the frame's third column again, for normal rendering).
+/// The op's output is four planes, one after the other, each `[G, width]` row-major: means (3),
+/// frames (9, row-major with columns t1, t2, n), scales (3) and normals (3, the frame's third
+/// column again, for normal rendering). Planes rather than one `[G, 18]` row per Gaussian so
+/// that each is a contiguous view: narrowing rows would make the renderer copy every column
+/// block forward and Burn copy it again backward.
+pub const PLANES: [usize; 4] = [3, 9, 3, 3];
+
+/// Values per Gaussian in the op's output.
 pub const PACKED: usize = 18;
 
 /// A fixed mesh's faces and one-rings (each ring sorted, as `MeshIndex` pads them).
@@ -71,7 +77,8 @@ impl BindConfig {
 /// Backends that run the fused binding.
 #[backend_extension(Flex, Autodiff)]
 pub trait BindingBackend: Backend {
-    /// `[G, PACKED]` Gaussians of posed vertices `[V, 3]`, face Gaussians first.
+    /// `[G · PACKED]` Gaussians of posed vertices `[V, 3]` as [`PLANES`], face Gaussians first in
+    /// each.
     fn tavatar_bind_forward(vertices: FloatTensor<Self>, config: BindConfig) -> FloatTensor<Self>;
 
     /// The `[V, 3]` gradient of the vertices given the gradient `grad` of the forward output.
@@ -86,14 +93,20 @@ pub trait BindingBackend: Backend {
 /// [`crate::host_ops::supported`] device, differentiable with respect to the vertices.
 pub fn bind(vertices: Tensor<2>, config: &BindConfig) -> GaussianGeometry {
     let g = config.num_gaussians();
-    let packed = Tensor::<2>::from_dispatch(<Dispatch as BindingBackend>::tavatar_bind_forward(
+    let planes = Tensor::<1>::from_dispatch(<Dispatch as BindingBackend>::tavatar_bind_forward(
         vertices.into_dispatch(),
         config.clone(),
     ));
+    let mut start = 0;
+    let [means, frames, scales, normals] = PLANES.map(|width| {
+        let plane = planes.clone().narrow(0, start, width * g);
+        start += width * g;
+        plane
+    });
     GaussianGeometry {
-        means: packed.clone().narrow(1, 0, 3),
-        frames: packed.clone().narrow(1, 3, 9).reshape([g, 3, 3]),
-        scales: packed.clone().narrow(1, 12, 3),
-        normals: packed.narrow(1, 15, 3),
+        means: means.reshape([g, 3]),
+        frames: frames.reshape([g, 3, 3]),
+        scales: scales.reshape([g, 3]),
+        normals: normals.reshape([g, 3]),
     }
 }
