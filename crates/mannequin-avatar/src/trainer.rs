@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use burn::tensor::{Tensor, TensorData};
+use burn::tensor::{Gradients, Tensor, TensorData};
 use mannequin_data::rng::SplitMix64;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
@@ -209,6 +209,17 @@ impl Trainer {
     /// One iteration on the next view.
     pub fn step(&mut self) -> Result<StepStats, AvatarError> {
         self.apply_schedule();
+        let (grads, value, psnr, mut t) = self.loss_and_gradients()?;
+        let clock = Instant::now();
+        self.adam.update(&mut self.avatar.params, &grads);
+        t.optimiser = clock.elapsed();
+        self.iteration += 1;
+        Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
+    }
+
+    /// This iteration's gradients, loss and PSNR. Every forward tensor is dropped on return, so
+    /// the optimiser finds the parameters' buffers unshared and updates them in place.
+    fn loss_and_gradients(&self) -> Result<(Gradients, f64, f64, Timings), AvatarError> {
         let n = self.views.len();
         let (epoch, k) = (self.iteration / n, self.iteration % n);
         let coarse =
@@ -270,11 +281,7 @@ impl Trainer {
         let clock = Instant::now();
         let grads = loss.backward();
         t.backward = clock.elapsed();
-        let clock = Instant::now();
-        self.adam.update(&mut self.avatar.params, &grads);
-        t.optimiser = clock.elapsed();
-        self.iteration += 1;
-        Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
+        Ok((grads, value, psnr, t))
     }
 
     /// Mean wall time of the splatting backward alone (Gaussians as leaves) on the first view,
