@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::{BindConfig, PACKED, PLANES, Topology};
+use super::{BindConfig, PACKED, PLANES, Topology, plane_starts};
 use crate::mesh_gaussians::{FACE_SCALE, NORM_EPS, NORMAL_SCALE, VERTEX_SCALE};
 
 type V3 = [f32; 3];
@@ -90,12 +90,8 @@ fn rows_mut(out: &mut [f32], g: usize, range: Range<usize>) -> impl IndexedParal
 
 /// Row `k`'s gradient in the planes of `grad` (`g` Gaussians).
 fn row_grad(grad: &[f32], g: usize, k: usize) -> RowGrad<'_> {
-    let mut start = 0;
-    PLANES.map(|w| {
-        let row = &grad[start + w * k..start + w * (k + 1)];
-        start += w * g;
-        row
-    })
+    let starts = plane_starts(g);
+    std::array::from_fn(|p| &grad[starts[p] + PLANES[p] * k..][..PLANES[p]])
 }
 
 /// What Eqs. 5–8 read of one face.

@@ -26,6 +26,16 @@ pub const PLANES: [usize; 4] = [3, 9, 3, 3];
 /// Values per Gaussian in the op's output.
 pub const PACKED: usize = 18;
 
+/// Where each of the [`PLANES`] starts in the output for `g` Gaussians.
+pub(crate) fn plane_starts(g: usize) -> [usize; 4] {
+    let mut start = 0;
+    PLANES.map(|width| {
+        let plane = start;
+        start += width * g;
+        plane
+    })
+}
+
 /// A fixed mesh's faces and one-rings (each ring sorted, as `MeshIndex` pads them).
 #[derive(Debug)]
 pub struct Topology {
@@ -97,12 +107,9 @@ pub fn bind(vertices: Tensor<2>, config: &BindConfig) -> GaussianGeometry {
         vertices.into_dispatch(),
         config.clone(),
     ));
-    let mut start = 0;
-    let [means, frames, scales, normals] = PLANES.map(|width| {
-        let plane = planes.clone().narrow(0, start, width * g);
-        start += width * g;
-        plane
-    });
+    let starts = plane_starts(g);
+    let [means, frames, scales, normals] =
+        std::array::from_fn(|p| planes.clone().narrow(0, starts[p], PLANES[p] * g));
     GaussianGeometry {
         means: means.reshape([g, 3]),
         frames: frames.reshape([g, 3, 3]),

@@ -78,10 +78,21 @@ fn narrow_layer<const K: usize, const N: usize>(h: &[f32; K], wt: &[[f32; K]; N]
     })
 }
 
-/// Zeroes the gradient where the layer's output `h` was clipped by its ReLU.
-fn mask<const N: usize>(g: &mut [[f32; N]; TILE], h: &[[f32; N]; TILE]) {
-    let h = h.as_flattened();
-    g.as_flattened_mut().iter_mut().zip(h).for_each(|(g, h)| *g = if *h > 0.0 { *g } else { 0.0 });
+/// `g = upstream·Wᵀ` for a tile (from `wt = Wᵀ`), zeroed where the layer's input `h` was
+/// clipped by its ReLU (none for the network's input).
+#[inline(always)]
+fn back_layer<const K: usize, const N: usize>(
+    g: &mut [[f32; N]; TILE],
+    upstream: &[[f32; K]; TILE],
+    wt: &[[f32; N]; K],
+    h: Option<&[[f32; N]; TILE]>,
+) {
+    g.fill([0.0; N]);
+    mul_add::<MR, TILE, K, N>(g, |r, k| upstream[r][k], wt);
+    if let Some(h) = h {
+        let h = h.as_flattened();
+        g.as_flattened_mut().iter_mut().zip(h).for_each(|(g, h)| *g = if *h > 0.0 { *g } else { 0.0 });
+    }
 }
 
 fn transpose<const M: usize, const N: usize>(a: &[[f32; N]; M]) -> [[f32; M]; N] {
@@ -189,14 +200,9 @@ pub fn backward<const I: usize, const H: usize, const O: usize>(
                 let m = t.hidden(&x[..rows_c.end * I], start, p);
                 load(&mut t.g2, &grad[..rows_c.end * O], start);
                 let Tile { x, h1, h2, g0, g1, g2, dx: dx_t } = &mut *t;
-                g1.fill([0.0; H]);
-                mul_add::<MR, TILE, O, H>(g1, |r, k| g2[r][k], &wt2);
-                mask(g1, h2);
-                g0.fill([0.0; H]);
-                mul_add::<MR, TILE, H, H>(g0, |r, k| g1[r][k], &wt1);
-                mask(g0, h1);
-                dx_t.fill([0.0; I]);
-                mul_add::<MR, TILE, H, I>(dx_t, |r, k| g0[r][k], &wt0);
+                back_layer(g1, g2, &wt2, Some(h2));
+                back_layer(g0, g1, &wt1, Some(h1));
+                back_layer(dx_t, g0, &wt0, None);
                 dx.extend_from_slice(dx_t[..m].as_flattened());
                 mul_add::<MR, I, TILE, H>(rows_mut(&mut dw[0]), |i, r| x[r][i], g0);
                 mul_add::<MR, H, TILE, H>(rows_mut(&mut dw[1]), |i, r| h1[r][i], g1);
