@@ -15,7 +15,12 @@
 //! `--half-resolution-share F` trains the first share F of the iterations at half resolution
 //! (default 0.5; 0 trains all at full resolution, the baseline of that schedule).
 //!
-//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE] [--half-resolution-share F]`
+//! `--pose-noise DEG` trains on poses perturbed as a monocular pose estimator would leave them:
+//! each axis-angle component of every joint below the root gets seeded normal noise of DEG
+//! degrees (default 0). The root is left exact, as a camera-relative fit pins it best. Evaluation
+//! keeps the exact test poses.
+//!
+//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE] [--half-resolution-share F] [--pose-noise DEG]`
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -29,6 +34,7 @@ use mannequin_avatar::{
 use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
 use mannequin_data::evaluation::EvalOptions;
+use mannequin_data::rng::SplitMix64;
 use mannequin_data::synth::{SynthOptions, generate};
 
 fn ms(d: Duration) -> f64 {
@@ -132,7 +138,8 @@ fn main() {
         println!("subject: synth seed {subject} ({:?}), {iters} iterations", summary.subject.outfit);
         let dataset = Dataset::open(&data, 1).expect("dataset");
         let split = dataset.split("train").expect("split");
-        let views = load_views(&dataset, &split, |_, _| {}).expect("views");
+        let mut views = load_views(&dataset, &split, |_, _| {}).expect("views");
+        perturb_poses(&mut views, arg("--pose-noise", 0.0), subject);
         let (canonical, skirt) =
             Canonical::for_subject(&model, &split.poses.betas, 0, &views, skirt_mode).expect("canonical");
         if let Some(layer) = &skirt {
@@ -178,6 +185,21 @@ fn main() {
         ablation_table(&table);
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Adds seeded normal noise of `degrees` to every axis-angle component of every training pose's
+/// joints below the root.
+fn perturb_poses(views: &mut [View], degrees: f64, seed: u64) {
+    if degrees <= 0.0 {
+        return;
+    }
+    println!("  training poses perturbed by {degrees}° per axis-angle component");
+    let mut rng = SplitMix64::new(seed ^ 0x706f_7365);
+    for view in views {
+        for v in &mut view.pose[3..] {
+            *v += (rng.normal() * degrees.to_radians()) as f32;
+        }
+    }
 }
 
 /// One subject's scores against the targets.
