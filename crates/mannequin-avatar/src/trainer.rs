@@ -24,8 +24,8 @@ pub const FINAL_LR_FACTOR: f64 = 0.1;
 /// Share of the iterations, from the start, trained on views at half resolution: their render
 /// and image losses cost a quarter as much (the per-Gaussian render work, offset field,
 /// optimiser and mesh terms do not shrink, so an iteration costs about three quarters of a
-/// full-resolution one on the synthetic dress), and the first iterations
-/// fit shape and mean colour, which half the pixels show as well.
+/// full-resolution one on the synthetic dress), and the first iterations fit shape and mean
+/// colour, which half the pixels show as well.
 pub const HALF_RESOLUTION_SHARE: f64 = 0.5;
 
 /// Loss weights and switches.

@@ -23,8 +23,8 @@ use crate::mesh_gaussians::GaussianGeometry;
 /// block forward and Burn copy it again backward.
 pub const PLANES: [usize; 4] = [3, 9, 3, 3];
 
-/// Values per Gaussian in the op's output.
-pub const PACKED: usize = 18;
+/// Values per Gaussian in the op's output: the [`PLANES`]' widths summed.
+pub const PACKED: usize = PLANES[0] + PLANES[1] + PLANES[2] + PLANES[3];
 
 /// Where each of the [`PLANES`] starts in the output for `g` Gaussians.
 pub(crate) fn plane_starts(g: usize) -> [usize; 4] {
