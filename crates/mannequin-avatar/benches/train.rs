@@ -26,13 +26,14 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use burn::tensor::Device;
-use mannequin_avatar::evaluation::{AvatarScores, evaluate_avatar};
+use mannequin_avatar::evaluation::evaluate_avatar;
 use mannequin_avatar::{
     Avatar, AvatarConfig, Canonical, HALF_RESOLUTION_SHARE, Method, SkirtMode, Timings, TrainOptions,
     Trainer, View, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
+use mannequin_data::Scores;
 use mannequin_data::evaluation::EvalOptions;
 use mannequin_data::rng::SplitMix64;
 use mannequin_data::synth::{SynthOptions, generate};
@@ -70,7 +71,7 @@ fn run(
     options: TrainOptions,
     subject: &Subject,
     breakdown: bool,
-) -> (AvatarScores, f64) {
+) -> (Scores, f64) {
     let Subject { canonical, views, data, dir } = *subject;
     let avatar = Avatar::new(config, canonical.clone(), &Device::flex().autodiff()).expect("avatar");
     let gaussians = avatar.num_gaussians();
@@ -203,10 +204,10 @@ fn perturb_poses(views: &mut [View], degrees: f64, seed: u64) {
 }
 
 /// One subject's scores against the targets.
-fn targets(s: &AvatarScores, full: &AvatarConfig, projected: f64) {
+fn targets(s: &Scores, full: &AvatarConfig, projected: f64) {
     let aa = if full.antialiased { ", antialiased" } else { "" };
     println!("targets (Tavatar, full, screen filter {} px²{aa}):", full.dilation);
-    let nv = &s.novel_view;
+    let nv = s.novel_view.as_ref().expect("a synthetic subject has a novel-view set");
     row("novel-view PSNR (dB)", nv.psnr, ">= 30", nv.psnr >= 30.0);
     row("novel-view SSIM", nv.ssim, ">= 0.97", nv.ssim >= 0.97);
     if let Some(np) = &s.novel_pose {

@@ -16,7 +16,7 @@ fn legacy_dilation() -> f64 {
 }
 
 /// How Gaussians are bound to the mesh.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// Tavatar: attributes derived analytically from the posed mesh; only colour is learned.
@@ -29,11 +29,8 @@ pub enum Method {
 impl std::str::FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "tavatar" => Ok(Self::Tavatar),
-            "ihuman" => Ok(Self::Ihuman),
-            _ => Err(format!("unknown method '{s}' (expected tavatar or ihuman)")),
-        }
+        <Self as clap::ValueEnum>::from_str(s, false)
+            .map_err(|_| format!("unknown method '{s}' (expected tavatar or ihuman)"))
     }
 }
 

@@ -42,7 +42,7 @@ const EDGE: f32 = 0.015;
 const HEM_MARGIN: f32 = 0.08;
 
 /// Whether to add the layer: when the masks show a skirt, or never.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SkirtMode {
     Auto,
     Off,
@@ -51,11 +51,8 @@ pub enum SkirtMode {
 impl std::str::FromStr for SkirtMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(Self::Auto),
-            "off" => Ok(Self::Off),
-            _ => Err(format!("unknown skirt mode '{s}' (expected auto or off)")),
-        }
+        <Self as clap::ValueEnum>::from_str(s, false)
+            .map_err(|_| format!("unknown skirt mode '{s}' (expected auto or off)"))
     }
 }
 

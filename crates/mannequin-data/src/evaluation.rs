@@ -1,6 +1,8 @@
 //! Frame-by-frame comparison of a predicted folder with a ground-truth dataset folder.
 //!
-//! Frames are matched by image name (`images/image_NNNN.png` present in both). The ground
+//! The frames scored are the ground truth's test frames, named by the caller: a prediction
+//! missing for one of them is an error, and other files in the prediction folder (left by an
+//! earlier run, say) are never scored. The ground
 //! truth is composited on the stated background with its mask; the prediction is taken as
 //! rendered. Where both folders hold normal maps (`normals/`) or meshes (`meshes/`), normal and
 //! geometry metrics are added. A ground truth at an integer multiple of the prediction's size
@@ -9,6 +11,8 @@
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
+
+use crate::dataset::Dataset;
 
 use crate::error::DataError;
 use crate::image::Image;
@@ -60,32 +64,13 @@ pub struct EvalSummary {
     pub per_frame: Vec<FrameScores>,
 }
 
-/// Frame numbers of `images/image_NNNN.png` in `root`, sorted.
-fn image_frames(root: &Path) -> Result<Vec<usize>, DataError> {
-    let dir = root.join(layout::IMAGES);
-    let mut frames = Vec::new();
-    for entry in std::fs::read_dir(&dir).map_err(|e| DataError::os(&dir, e))? {
-        let entry = entry.map_err(|e| DataError::os(&dir, e))?;
-        if let Some(n) = layout::frame_number(&entry.file_name().to_string_lossy(), "image", "png") {
-            frames.push(n);
-        }
-    }
-    frames.sort_unstable();
-    Ok(frames)
-}
-
-/// The frames both folders have, in order.
-pub fn matching_frames(pred: &Path, gt: &Path) -> Result<Vec<usize>, DataError> {
-    let gt_frames = image_frames(gt)?;
-    let common: Vec<usize> =
-        image_frames(pred)?.into_iter().filter(|f| gt_frames.binary_search(f).is_ok()).collect();
-    if common.is_empty() {
-        return Err(DataError::file(
-            pred.join(layout::IMAGES),
-            format!("no image_NNNN.png shares a name with {}", gt.join(layout::IMAGES).display()),
-        ));
-    }
-    Ok(common)
+/// The frames of `gt`'s test split: what a prediction folder for it is scored on.
+pub fn test_frames(gt: &Path) -> Result<Vec<usize>, DataError> {
+    let dataset = Dataset::open(gt, 1)?;
+    let range = dataset.splits.get("test").ok_or_else(|| {
+        DataError::file(gt, "has no 'test' split to score (see docs/dataset-format.md, splits.json)")
+    })?;
+    Ok(range.frames())
 }
 
 /// The integer factor from `pred`'s size to `gt`'s, or an error naming both files.
@@ -190,17 +175,21 @@ fn score_frame(
     ))
 }
 
-/// Compares every matching frame; `on_frame` is called after each (for progress display).
+/// Compares the prediction of each of `frames` with the ground truth; `on_frame` is called
+/// after each (for progress display).
 pub fn evaluate(
     pred: &Path,
     gt: &Path,
+    frames: &[usize],
     opt: &EvalOptions,
     on_frame: &dyn Fn(&FrameScores),
 ) -> Result<EvalSummary, DataError> {
-    let frames = matching_frames(pred, gt)?;
+    if frames.is_empty() {
+        return Err(DataError::file(gt, "no test frames to score"));
+    }
     let mut per_frame = Vec::with_capacity(frames.len());
     let mut gt_downscale = 1;
-    for &f in &frames {
+    for &f in frames {
         let (scores, factor) = score_frame(pred, gt, f, opt)?;
         gt_downscale = factor;
         on_frame(&scores);

@@ -1,5 +1,5 @@
 //! `evaluate` on small folders whose scores are known without computing them: a perfect
-//! prediction, a ground truth at twice the size, frames matched by name, and size errors.
+//! prediction, a ground truth at twice the size, exactly the frames asked for, and errors.
 
 use std::path::PathBuf;
 
@@ -78,7 +78,7 @@ fn options() -> EvalOptions {
 }
 
 #[test]
-fn a_perfect_prediction_scores_perfectly_on_the_frames_both_have() {
+fn a_perfect_prediction_scores_perfectly_on_the_frames_asked_for() {
     let gt = write_gt("gt-perfect", 32, 3);
     let pred = temp_dir("pred-perfect");
     let w = DatasetWriter::new(&pred);
@@ -87,7 +87,8 @@ fn a_perfect_prediction_scores_perfectly_on_the_frames_both_have() {
         w.write_mesh(i, &tetrahedron(0.0)).unwrap();
     }
     let seen = std::sync::Mutex::new(Vec::new());
-    let s = evaluate(&pred, &gt, &options(), &|f| seen.lock().unwrap().push(f.frame)).unwrap();
+    // Frame 7 is not asked for (a stale file, say), so it is not scored.
+    let s = evaluate(&pred, &gt, &[0, 2], &options(), &|f| seen.lock().unwrap().push(f.frame)).unwrap();
     assert_eq!(seen.into_inner().unwrap(), vec![0, 2]);
     assert_eq!(s.frames, 2);
     assert_eq!(s.gt_downscale, 1);
@@ -109,7 +110,7 @@ fn a_perfect_prediction_scores_perfectly_on_the_frames_both_have() {
     for i in [0, 2] {
         w.write_mesh(i, &tetrahedron(0.01)).unwrap();
     }
-    let s = evaluate(&pred, &gt, &options(), &|_| {}).unwrap();
+    let s = evaluate(&pred, &gt, &[0, 2], &options(), &|_| {}).unwrap();
     let p2s = s.p2s_cm.unwrap();
     assert!(p2s > 0.1 && p2s <= 1.0 + 1e-6, "{p2s}");
     for d in [gt, pred] {
@@ -129,7 +130,7 @@ fn ground_truth_at_twice_the_size_is_downscaled() {
     p.mask = p.mask.downscale(2);
     p.normals = p.normals.map(|n| n.downscale(2));
     DatasetWriter::new(&pred).write_frame(&p).unwrap();
-    let s = evaluate(&pred, &gt, &options(), &|_| {}).unwrap();
+    let s = evaluate(&pred, &gt, &[0], &options(), &|_| {}).unwrap();
     assert_eq!(s.gt_downscale, 2);
     // Equal up to float rounding in the block means (and renormalised normals).
     assert!(s.psnr > 100.0, "{}", s.psnr);
@@ -144,12 +145,15 @@ fn sizes_that_do_not_divide_name_the_files() {
     let gt = write_gt("gt-odd", 32, 1);
     let pred = temp_dir("pred-odd");
     DatasetWriter::new(&pred).write_frame(&perfect_prediction(0, 24)).unwrap();
-    let msg = evaluate(&pred, &gt, &options(), &|_| {}).err().unwrap().to_string();
+    let msg = evaluate(&pred, &gt, &[0], &options(), &|_| {}).err().unwrap().to_string();
     assert!(msg.contains("image_0000.png") && msg.contains("24×24") && msg.contains("32×32"), "{msg}");
     let empty = temp_dir("pred-none");
     std::fs::create_dir_all(empty.join("images")).unwrap();
-    let msg = evaluate(&empty, &gt, &options(), &|_| {}).err().unwrap().to_string();
-    assert!(msg.contains("no image_NNNN.png"), "{msg}");
+    // A prediction missing for a frame asked for is an error naming its file, not a skip.
+    let msg = evaluate(&empty, &gt, &[0], &options(), &|_| {}).err().unwrap().to_string();
+    assert!(msg.contains("pred-none") && msg.contains("image_0000.png"), "{msg}");
+    let msg = evaluate(&pred, &gt, &[], &options(), &|_| {}).err().unwrap().to_string();
+    assert!(msg.contains("no test frames"), "{msg}");
     for d in [gt, pred, empty] {
         std::fs::remove_dir_all(d).unwrap();
     }

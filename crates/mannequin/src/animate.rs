@@ -1,6 +1,5 @@
-//! `mannequin animate`: drive a body with a motion file and write a skinned, animated `.glb`; or,
-//! with `--avatar`, render a trained avatar at every frame of the motion to PNGs (and an `.mp4`
-//! where ffmpeg is installed).
+//! `mannequin animate`: render a trained avatar at every frame of a motion to PNGs (and an
+//! `.mp4` where ffmpeg is installed). A skinned `.glb` of a bare body is `mannequin body animate`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -9,82 +8,39 @@ use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
 use clap::Args as ClapArgs;
 use mannequin_avatar::{Avatar, predict};
-use mannequin_body::{Motion, skeletal_animation, skinned_body};
+use mannequin_body::Motion;
 use mannequin_splat::Camera;
 
-use crate::body::{BodyArgs, load_model};
+use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
-use crate::render::{box_centre, front_camera, write_map};
+use crate::render::{Map, box_centre, front_camera, write_map};
 use crate::splat::read_camera;
 
 #[derive(ClapArgs)]
 #[command(
-    after_help = "Body mode (default): --model/--betas and -o walk.glb write a skinned, animated glTF.\n\
-Avatar mode: --avatar MODEL_DIR and -o OUT_DIR render OUT_DIR/frame_0000.png, ... through --camera or a \
-fixed front camera framing the whole clip, and OUT_DIR/animation.mp4 when ffmpeg is on PATH."
+    after_help = "Writes OUT_DIR/frame_0000.png, ... through --camera or a fixed front camera framing the \
+whole clip, and OUT_DIR/animation.mp4 when ffmpeg is on PATH."
 )]
 pub struct Args {
+    /// Trained avatar folder (written by `mannequin train`).
+    #[arg(long)]
+    avatar: PathBuf,
     #[command(flatten)]
-    body: BodyArgs,
-    /// Render this trained avatar (a `mannequin train` model folder) instead of writing a .glb.
-    #[arg(long, conflicts_with_all = ["model", "betas"])]
-    avatar: Option<PathBuf>,
-    /// AMASS or PeopleSnapshot `.npz` motion.
+    clip: Clip,
+    /// Camera JSON (K, extrinsic, width, height); default: a fixed front view.
     #[arg(long)]
-    motion: PathBuf,
-    /// Resample the motion to this frame rate (default: the file's own).
-    #[arg(long)]
-    fps: Option<f32>,
-    /// Use only the first N frames (after resampling).
-    #[arg(long)]
-    max_frames: Option<usize>,
-    /// Camera JSON (K, extrinsic, width, height) for --avatar; default: a fixed front view.
-    #[arg(long, requires = "avatar")]
     camera: Option<PathBuf>,
-    /// What --avatar renders: rgb or normals.
-    #[arg(long, default_value = "rgb", value_parser = ["rgb", "normals"], requires = "avatar")]
-    what: String,
-    /// Output: the `.glb` (body mode), or the folder of frames (--avatar).
+    /// What to render.
+    #[arg(long, value_enum, default_value_t = Map::Rgb)]
+    what: Map,
+    /// Output folder of frames.
     #[arg(short, long)]
     output: PathBuf,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let mut motion = Motion::read(&args.motion)?;
-    if let Some(fps) = args.fps {
-        motion = motion.resample(fps)?;
-    }
-    if let Some(n) = args.max_frames {
-        if n == 0 {
-            bail!("--max-frames must be at least 1");
-        }
-        let n = n.min(motion.num_frames());
-        motion.poses.truncate(n * 3 * motion.joints);
-        motion.trans.truncate(3 * n);
-    }
-    match &args.avatar {
-        Some(dir) => animate_avatar(&args, dir, &motion),
-        None => animate_body(&args, &motion),
-    }
-}
-
-fn animate_body(args: &Args, motion: &Motion) -> Result<()> {
-    let model = load_model(&args.body.model)?;
-    let poses = motion.poses_for(&model)?;
-    let skinned = skinned_body(&model, &args.body.betas)?;
-    let animation = skeletal_animation(&model, &poses, &motion.trans, motion.fps)?;
-    mannequin_mesh::gltf::write_glb(&args.output, &skinned, Some(&animation))
-        .with_context(|| format!("writing {}", args.output.display()))?;
-    tracing::info!(
-        "wrote {}: {} frames at {} fps ({:.1} s), {} vertices, {} joints",
-        args.output.display(),
-        motion.num_frames(),
-        motion.fps,
-        motion.num_frames().saturating_sub(1) as f32 / motion.fps,
-        model.num_vertices(),
-        model.num_joints()
-    );
-    Ok(())
+    let motion = args.clip.load()?;
+    animate_avatar(&args, &motion)
 }
 
 /// `render`'s front camera on the centre of the clip's bounding box `lo`–`hi`, moved back until
@@ -106,9 +62,9 @@ fn clip_camera(lo: [f32; 3], hi: [f32; 3]) -> Camera {
     Camera::look_at(eye, c, [0.0, 1.0, 0.0], 2.0 * tan_half.atan(), camera.width, camera.height)
 }
 
-fn animate_avatar(args: &Args, dir: &Path, motion: &Motion) -> Result<()> {
+fn animate_avatar(args: &Args, motion: &Motion) -> Result<()> {
     let _timer = JobTimer::start("animate");
-    let avatar = Avatar::load(dir, &Device::flex())?;
+    let avatar = Avatar::load(&args.avatar, &Device::flex())?;
     let joints = avatar.canonical.num_joints();
     let poses = motion.poses_for_joints(joints)?;
     let frames = motion.num_frames();
@@ -134,7 +90,7 @@ fn animate_avatar(args: &Args, dir: &Path, motion: &Motion) -> Result<()> {
     let progress = bar(frames as u64, "rendering");
     for f in 0..frames {
         let p = predict(&avatar, &camera, pose(f), transl(f))?;
-        write_map(&p, &args.what, &args.output.join(format!("frame_{f:04}.png")))?;
+        write_map(&p, args.what, &args.output.join(format!("frame_{f:04}.png")))?;
         progress.inc(1);
     }
     progress.finish_and_clear();

@@ -55,14 +55,14 @@ pub fn run(args: Args) -> Result<()> {
                 "--restart",
             ],
         ),
-        ("evaluate", vec!["eval", "--model", &avatar, "--data", &subject, "--json", &eval_json]),
+        ("evaluate", vec!["eval", "--avatar", &avatar, "--data", &subject, "--json", &eval_json]),
         ("motion", vec!["motion", "walk", "-o", &walk]),
         (
             "animate",
             vec!["animate", "--avatar", &avatar, "--motion", &walk, "--max-frames", &frames, "-o", &walk_dir],
         ),
-        ("export", vec!["export", "--model", &avatar, "-o", &glb, "--gaussians", &splats]),
-        ("export", vec!["export", "--model", &avatar, "--pose", "squat", "-o", &squat]),
+        ("export", vec!["export", "--avatar", &avatar, "-o", &glb, "--gaussians", &splats]),
+        ("export", vec!["export", "--avatar", &avatar, "--named-pose", "squat", "-o", &squat]),
     ];
     let count = stages.len();
     for (i, (name, argv)) in stages.into_iter().enumerate() {
@@ -72,7 +72,7 @@ pub fn run(args: Args) -> Result<()> {
         crate::dispatch(cli.command).with_context(|| format!("demo stage {name}"))?;
     }
     set_stage("");
-    println!(
+    tracing::info!(
         "demo done: {}/avatar (model), eval.json, walk/ (frames), avatar.glb, avatar_gaussians.ply, avatar_squat.obj",
         args.out.display()
     );

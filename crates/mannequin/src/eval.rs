@@ -1,31 +1,39 @@
-//! `mannequin eval`: compare a folder of predictions with a ground-truth dataset folder, frame by
-//! frame, or a trained avatar with a dataset's test sets; print a table and optionally write the
-//! scores as JSON.
+//! `mannequin eval`: score a trained avatar on a dataset's test sets, or a folder of
+//! predictions against a ground-truth dataset's test frames. Both print one table and write
+//! one JSON layout (`novel_view` / `novel_pose` / `test` / `geometry`).
 
+use std::cell::RefCell;
 use std::path::PathBuf;
 
-use anyhow::Context;
-use mannequin_data::evaluation::{EvalOptions, EvalSummary, FrameScores, evaluate, matching_frames};
+use anyhow::{Context, Result};
+use indicatif::ProgressBar;
+use mannequin_avatar::evaluation::evaluate_avatar;
+use mannequin_data::evaluation::{EvalOptions, evaluate, test_frames};
 use mannequin_data::metrics::lpips::Lpips;
+use mannequin_data::{Scores, TestSet};
 
-use crate::eval_avatar::{evaluate_with_progress, print_scores};
 use crate::progress::{JobTimer, bar};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Folder of predictions: images/image_NNNN.png, optionally normals/ and meshes/.
-    #[arg(long, required_unless_present = "model", conflicts_with = "model", requires = "gt")]
+    /// A trained avatar folder (written by `mannequin train`), rendered and scored on --data's
+    /// test sets (predictions are kept under AVATAR/eval/<set>/).
+    #[arg(long, required_unless_present = "pred", conflicts_with = "pred", requires = "data")]
+    avatar: Option<PathBuf>,
+    /// Dataset folder whose test sets the avatar is scored on: test/novel_view and
+    /// test/novel_pose of `mannequin synth`, or else the folder's own test split (`test`).
+    #[arg(long, requires = "avatar")]
+    data: Option<PathBuf>,
+    /// Folder of predictions (images/image_NNNN.png, optionally normals/ and meshes/) for the
+    /// test frames of --gt.
+    #[arg(long, requires = "gt")]
     pred: Option<PathBuf>,
-    /// Ground-truth dataset folder (PeopleSnapshot layout, see docs/dataset-format.md).
+    /// Ground-truth dataset folder (see docs/dataset-format.md); its test split's frames are scored.
     #[arg(long, requires = "pred")]
     gt: Option<PathBuf>,
-    /// A trained avatar (model folder of `mannequin train`), scored on --data's test sets.
-    #[arg(long, requires = "data")]
-    model: Option<PathBuf>,
-    /// Dataset folder whose test sets the avatar is scored on (test/novel_view and
-    /// test/novel_pose of `mannequin synth`, or the folder's own test split).
-    #[arg(long, requires = "model")]
-    data: Option<PathBuf>,
+    /// What --gt's test frames are, which names them in the scores.
+    #[arg(long, value_enum, default_value_t = TestSet::Test, requires = "pred")]
+    set: TestSet,
     /// Write the scores (means and per frame) to this JSON file.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -43,7 +51,7 @@ pub struct Args {
     seed: u64,
 }
 
-fn parse_background(s: &str) -> anyhow::Result<[f32; 3]> {
+fn parse_background(s: &str) -> Result<[f32; 3]> {
     match s {
         "white" => Ok([1.0; 3]),
         "black" => Ok([0.0; 3]),
@@ -61,81 +69,79 @@ fn parse_background(s: &str) -> anyhow::Result<[f32; 3]> {
     }
 }
 
+/// Renders and scores the avatar's test sets with one progress bar per set.
+fn evaluate_with_progress(
+    avatar: &std::path::Path,
+    data: &std::path::Path,
+    options: &EvalOptions,
+) -> Result<Scores> {
+    let current: RefCell<Option<ProgressBar>> = RefCell::new(None);
+    let on_set = |set: TestSet, frames: usize| {
+        if let Some(b) = current.replace(Some(bar(2 * frames as u64, set.name()))) {
+            b.finish_and_clear();
+        }
+    };
+    let on_frame = || {
+        if let Some(b) = current.borrow().as_ref() {
+            b.inc(1);
+        }
+    };
+    let scores = evaluate_avatar(avatar, data, options, &on_set, &on_frame)?;
+    if let Some(b) = current.take() {
+        b.finish_and_clear();
+    }
+    Ok(scores)
+}
+
 fn cell(v: Option<f64>, digits: usize) -> String {
     v.map_or("-".into(), |v| format!("{v:.digits$}"))
 }
 
-fn row(label: &str, s: &FrameScores) -> String {
-    format!(
-        "{label:>8} {:>8.3} {:>7.4} {:>7} {:>9} {:>8} {:>8} {:>7} {:>6}",
-        s.psnr,
-        s.ssim,
-        cell(s.lpips, 4),
-        cell(s.normal_mse_x1e3, 2),
-        cell(s.normal_angle_deg, 2),
-        cell(s.chamfer_cm, 3),
-        cell(s.p2s_cm, 3),
-        cell(s.normal_consistency, 3)
-    )
-}
-
-fn print_table(summary: &EvalSummary) {
-    println!(
-        "{:>8} {:>8} {:>7} {:>7} {:>9} {:>8} {:>8} {:>7} {:>6}",
-        "frame", "PSNR", "SSIM", "LPIPS", "N-MSE×1e3", "N-angle°", "CD cm", "P2S cm", "NC"
-    );
-    for s in &summary.per_frame {
-        println!("{}", row(&format!("{:04}", s.frame), s));
+/// The scores as a table on stdout: a row per test set, then the geometry.
+fn print_scores(s: &Scores) {
+    println!("{:>11} {:>7} {:>8} {:>7} {:>7}", "test set", "frames", "PSNR", "SSIM", "LPIPS");
+    for (set, summary) in s.sets() {
+        println!(
+            "{:>11} {:>7} {:>8.2} {:>7.4} {:>7}",
+            set.name(),
+            summary.frames,
+            summary.psnr,
+            summary.ssim,
+            cell(summary.lpips, 4)
+        );
     }
-    let mean = FrameScores {
-        frame: 0,
-        psnr: summary.psnr,
-        ssim: summary.ssim,
-        lpips: summary.lpips,
-        normal_mse_x1e3: summary.normal_mse_x1e3,
-        normal_angle_deg: summary.normal_angle_deg,
-        chamfer_cm: summary.chamfer_cm,
-        p2s_cm: summary.p2s_cm,
-        normal_consistency: summary.normal_consistency,
-    };
-    println!("{}", row("mean", &mean));
+    let g = &s.geometry;
     println!(
-        "{} frames; ground truth composited on {:?}{}",
-        summary.frames,
-        summary.background,
-        if summary.gt_downscale > 1 {
-            format!(", downscaled ×{}", summary.gt_downscale)
-        } else {
-            String::new()
-        }
+        "geometry: Chamfer {} cm, P2S {} cm, normal consistency {}, normal angle {}°, normal MSE×1e3 {}",
+        cell(g.chamfer_cm, 3),
+        cell(g.p2s_cm, 3),
+        cell(g.normal_consistency, 3),
+        cell(g.normal_angle_deg, 2),
+        cell(g.normal_mse_x1e3, 2)
     );
 }
 
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("eval");
     let background = parse_background(&args.background)?;
     let lpips = args.lpips_weights.as_deref().map(Lpips::load).transpose()?;
     let options = EvalOptions { background, lpips, samples: args.samples, seed: args.seed };
-    let text = match (&args.model, &args.data, &args.pred, &args.gt) {
-        (Some(model), Some(data), _, _) => {
-            let scores = evaluate_with_progress(model, data, &options)?;
-            print_scores(&scores);
-            serde_json::to_string_pretty(&scores)?
-        }
+    let scores = match (&args.avatar, &args.data, &args.pred, &args.gt) {
+        (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, &options)?,
         (_, _, Some(pred), Some(gt)) => {
-            let frames = matching_frames(pred, gt)?;
-            let progress = bar(frames.len() as u64, "eval");
-            let summary = evaluate(pred, gt, &options, &|_| progress.inc(1))?;
+            let frames = test_frames(gt)?;
+            let progress = bar(frames.len() as u64, args.set.name());
+            let summary = evaluate(pred, gt, &frames, &options, &|_| progress.inc(1))?;
             progress.finish_and_clear();
-            print_table(&summary);
-            serde_json::to_string_pretty(&summary)?
+            Scores::new(vec![(args.set, summary)])
         }
-        _ => anyhow::bail!("give --model and --data, or --pred and --gt"),
+        _ => anyhow::bail!("give --avatar and --data, or --pred and --gt"),
     };
+    print_scores(&scores);
     if let Some(path) = &args.json {
-        mannequin_io::write_atomic(path, text.as_bytes())
+        mannequin_io::write_atomic(path, serde_json::to_string_pretty(&scores)?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
-        println!("wrote {}", path.display());
+        tracing::info!("wrote {}", path.display());
     }
     Ok(())
 }

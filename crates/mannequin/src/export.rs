@@ -8,28 +8,22 @@ use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
 use mannequin_avatar::params::host_rows;
 use mannequin_avatar::{Avatar, Posed, export};
-use mannequin_body::{Motion, named_pose};
 use mannequin_mesh::TriMesh;
 
 use crate::body::write_mesh;
+use crate::pose_choice::PoseChoice;
 use crate::progress::JobTimer;
 
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("outputs").required(true).multiple(true).args(["output", "gaussians"]))]
 pub struct Args {
-    /// Model folder written by `mannequin train`.
+    /// Trained avatar folder (written by `mannequin train`).
     #[arg(long)]
-    model: PathBuf,
-    /// Pose: `canonical` (zero pose and translation: the personalised canonical mesh) or a named
-    /// SMPL pose (t-pose, a-pose, arms-raised, squat, walk, arms-crossed).
-    #[arg(long, visible_alias = "named", default_value = "canonical", conflicts_with = "motion")]
-    pose: String,
-    /// AMASS or PeopleSnapshot motion file: pose and translation of its frame --frame.
-    #[arg(long)]
-    motion: Option<PathBuf>,
-    /// Frame of --motion.
-    #[arg(long, default_value_t = 0, requires = "motion")]
-    frame: usize,
+    avatar: PathBuf,
+    /// The pose: --motion/--frame or --named-pose; neither (or t-pose) is the canonical pose,
+    /// where the mesh is the personalised canonical mesh itself.
+    #[command(flatten)]
+    pose: PoseChoice,
     /// The mesh with vertex colour baked from the Gaussians, by extension: `.obj` or `.ply` at the
     /// pose, or a skinned `.glb` (bind pose: the canonical mesh; COLOR_0; the avatar's skeleton
     /// and weights; canonical pose only).
@@ -38,28 +32,6 @@ pub struct Args {
     /// The Gaussians at the pose as a 3DGS `.ply` in the INRIA layout, for splat viewers.
     #[arg(long)]
     gaussians: Option<PathBuf>,
-}
-
-impl Args {
-    /// The zero pose and translation, where the posed mesh is V_s itself.
-    fn canonical(&self) -> bool {
-        self.motion.is_none() && self.pose == "canonical"
-    }
-}
-
-/// Pose (3J values) and translation of the requested pose.
-fn chosen_pose(args: &Args, joints: usize) -> Result<(Vec<f32>, [f32; 3])> {
-    if let Some(path) = &args.motion {
-        return Ok(Motion::read(path)?.frame_pose(args.frame, joints)?);
-    }
-    if args.canonical() {
-        return Ok((vec![0.0; 3 * joints], [0.0; 3]));
-    }
-    let pose = named_pose(&args.pose)?;
-    if joints != pose.len() / 3 {
-        bail!("named poses are SMPL (24-joint) poses; this avatar has {joints} joints");
-    }
-    Ok((pose.to_vec(), [0.0; 3]))
 }
 
 /// Whether `-o` names a skinned `.glb` (else `.obj` or `.ply`; anything else is an error).
@@ -90,10 +62,10 @@ pub fn run(args: Args) -> Result<()> {
     // Every argument is checked before the model loads.
     let glb = args.output.as_deref().map(is_glb).transpose()?;
     if let (Some(true), Some(output)) = (glb, &args.output)
-        && !args.canonical()
+        && !args.pose.is_rest()
     {
         bail!(
-            "{}: a .glb is written at its bind pose (the canonical mesh); drop --pose/--motion, or write .obj/.ply",
+            "{}: a .glb is written at its bind pose (the canonical mesh); drop --named-pose/--motion, or write .obj/.ply",
             output.display()
         );
     }
@@ -102,17 +74,17 @@ pub fn run(args: Args) -> Result<()> {
     {
         bail!("{}: Gaussians are written as a 3DGS .ply; use a .ply extension", path.display());
     }
-    let avatar = Avatar::load(&args.model, &Device::flex())?;
-    let (pose, transl) = chosen_pose(&args, avatar.canonical.num_joints())?;
+    let avatar = Avatar::load(&args.avatar, &Device::flex())?;
+    let (pose, transl) = args.pose.resolve(avatar.canonical.num_joints())?;
     let posed = avatar.pose(&pose, transl)?;
     if let (Some(output), Some(glb)) = (&args.output, glb) {
-        write_output(&avatar, &posed, args.canonical(), glb, output)?;
-        println!("wrote {} ({} vertices)", output.display(), avatar.canonical.num_vertices());
+        write_output(&avatar, &posed, args.pose.is_rest(), glb, output)?;
+        tracing::info!("wrote {} ({} vertices)", output.display(), avatar.canonical.num_vertices());
     }
     if let Some(path) = &args.gaussians {
         let scene = export::gaussian_scene(&avatar, &posed.gaussians)?;
         scene.write_ply(path)?;
-        println!("wrote {} ({} Gaussians, SH degree {})", path.display(), scene.len(), scene.sh_degree);
+        tracing::info!("wrote {} ({} Gaussians, SH degree {})", path.display(), scene.len(), scene.sh_degree);
     }
     Ok(())
 }

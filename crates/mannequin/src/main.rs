@@ -5,9 +5,9 @@ mod animate;
 mod body;
 mod demo;
 mod eval;
-mod eval_avatar;
 mod export;
 mod motion;
+mod pose_choice;
 mod progress;
 mod render;
 mod splat;
@@ -28,18 +28,19 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Inspect or pose a body model (SMPL, SMPL-H, SMPL-X or the embedded default).
+    /// Inspect, pose or animate a body model (SMPL, SMPL-H, SMPL-X or the embedded default).
     #[command(subcommand)]
     Body(body::BodyCommand),
     /// Write motion files (a procedural walk as AMASS .npz).
     #[command(subcommand)]
     Motion(motion::MotionCommand),
-    /// Drive a body with an AMASS or PeopleSnapshot motion and write a skinned, animated .glb.
+    /// Render a trained avatar playing an AMASS or PeopleSnapshot motion, as PNG frames (and .mp4).
     Animate(animate::Args),
     /// The main job on the embedded default body: synthetic subject, training, evaluation,
     /// animation and export, under one folder.
     Demo(demo::Args),
-    /// Compare predictions with a ground-truth dataset: PSNR, SSIM, LPIPS, normal and geometry errors.
+    /// Score an avatar, or a folder of predictions, on a dataset's test sets: PSNR, SSIM, LPIPS,
+    /// normal and geometry errors.
     Eval(eval::Args),
     /// Generate a synthetic clothed subject with full ground truth, in the dataset layout.
     Synth(synth::Args),

@@ -1,9 +1,10 @@
 //! `mannequin motion walk`: a procedural walk written as an AMASS `.npz`, so the animation
-//! pipeline can be tried without a licensed motion download.
+//! pipeline can be tried without a licensed motion download; and the options of the verbs that
+//! play a whole motion.
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
 use mannequin_body::Motion;
 
@@ -32,5 +33,37 @@ pub fn run(cmd: MotionCommand) -> Result<()> {
             tracing::info!("wrote {} ({} frames at {} fps)", a.output.display(), walk.num_frames(), walk.fps);
             Ok(())
         }
+    }
+}
+
+/// A whole motion to play: the file, resampled and cut as asked.
+#[derive(Args)]
+pub struct Clip {
+    /// AMASS or PeopleSnapshot motion `.npz`.
+    #[arg(long)]
+    pub motion: PathBuf,
+    /// Resample the motion to this frame rate (default: the file's own).
+    #[arg(long)]
+    pub fps: Option<f32>,
+    /// Use only the first N frames (after resampling).
+    #[arg(long)]
+    pub max_frames: Option<usize>,
+}
+
+impl Clip {
+    pub fn load(&self) -> Result<Motion> {
+        let mut motion = Motion::read(&self.motion)?;
+        if let Some(fps) = self.fps {
+            motion = motion.resample(fps)?;
+        }
+        if let Some(n) = self.max_frames {
+            if n == 0 {
+                bail!("--max-frames must be at least 1");
+            }
+            let n = n.min(motion.num_frames());
+            motion.poses.truncate(n * 3 * motion.joints);
+            motion.trans.truncate(3 * n);
+        }
+        Ok(motion)
     }
 }

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use mannequin_splat::{Camera, RenderOptions, SplatScene, render};
-use serde_json::Value;
+use serde_json::{Value, json};
 
 use crate::progress::JobTimer;
 
@@ -53,13 +53,16 @@ enum Verb {
     Info {
         /// Splat file in the INRIA layout.
         file: PathBuf,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
     },
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     match args.verb {
         Verb::Render { ply, camera, output, dilation } => render_to_png(&ply, &camera, &output, dilation),
-        Verb::Info { file } => info(&file),
+        Verb::Info { file, json } => info(&file, json),
     }
 }
 
@@ -155,8 +158,8 @@ fn render_to_png(ply: &Path, camera: &Path, output: &Path, dilation: f64) -> any
     Ok(())
 }
 
-/// Minimum, mean and maximum of the finite values.
-fn stats(values: impl Iterator<Item = f64>) -> String {
+/// Minimum, mean and maximum of the finite values (`null` when none is finite).
+fn stats(values: impl Iterator<Item = f64>) -> Value {
     let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);
@@ -164,14 +167,18 @@ fn stats(values: impl Iterator<Item = f64>) -> String {
         sum += v;
         n += 1;
     }
-    if n == 0 {
-        "none finite".into()
-    } else {
-        format!("min {lo:.4}  mean {:.4}  max {hi:.4}", sum / n as f64)
+    if n == 0 { Value::Null } else { json!({"min": lo, "mean": sum / n as f64, "max": hi}) }
+}
+
+/// A `stats` value as a table cell.
+fn stats_cell(v: &Value) -> String {
+    match (v["min"].as_f64(), v["mean"].as_f64(), v["max"].as_f64()) {
+        (Some(lo), Some(mean), Some(hi)) => format!("min {lo:.4}  mean {mean:.4}  max {hi:.4}"),
+        _ => "none finite".into(),
     }
 }
 
-fn info(path: &Path) -> anyhow::Result<()> {
+fn info(path: &Path, as_json: bool) -> anyhow::Result<()> {
     let s = SplatScene::read_ply(path)?;
     let n = s.len();
     let g = s.gaussians();
@@ -187,17 +194,35 @@ fn info(path: &Path) -> anyhow::Result<()> {
                 .any(|v| !v.is_finite())
         })
         .count();
+    let axis = |k: usize| stats(s.means.iter().skip(k).step_by(3).map(|&v| v as f64));
+    let norms = s.quaternions.chunks_exact(4).map(|q| q.iter().map(|v| (v * v) as f64).sum::<f64>().sqrt());
+    let facts = json!({
+        "file": path.display().to_string(),
+        "gaussians": n,
+        "sh_degree": s.sh_degree,
+        "channels": g.channels(),
+        "non_finite": non_finite,
+        "mean_x": axis(0),
+        "mean_y": axis(1),
+        "mean_z": axis(2),
+        "opacity": stats(s.opacities.iter().map(|&v| v as f64)),
+        "scale": stats(s.scales.iter().map(|&v| v as f64)),
+        "quaternion_norm": stats(norms),
+    });
+    if as_json {
+        println!("{}", serde_json::to_string_pretty(&facts)?);
+        return Ok(());
+    }
     println!("{}", path.display());
     println!("  Gaussians       {n}");
     println!("  SH degree       {} ({} channels)", s.sh_degree, g.channels());
     println!("  non-finite      {non_finite}");
-    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
-        println!("  mean {name}          {}", stats(s.means.iter().skip(axis).step_by(3).map(|&v| v as f64)));
+    for name in ["x", "y", "z"] {
+        println!("  mean {name}          {}", stats_cell(&facts[format!("mean_{name}")]));
     }
-    println!("  opacity         {}", stats(s.opacities.iter().map(|&v| v as f64)));
-    println!("  scale (σ, m)    {}", stats(s.scales.iter().map(|&v| v as f64)));
-    let norms = s.quaternions.chunks_exact(4).map(|q| q.iter().map(|v| (v * v) as f64).sum::<f64>().sqrt());
-    println!("  |quaternion|    {}", stats(norms));
+    println!("  opacity         {}", stats_cell(&facts["opacity"]));
+    println!("  scale (σ, m)    {}", stats_cell(&facts["scale"]));
+    println!("  |quaternion|    {}", stats_cell(&facts["quaternion_norm"]));
     Ok(())
 }
 

@@ -17,7 +17,7 @@ pub struct Args {
     out: PathBuf,
     /// Body model: `default`, `default-lod1`, or a SMPL-family .npz.
     #[arg(long, default_value = "default")]
-    model: String,
+    body: String,
     /// Image width and height in pixels.
     #[arg(long, default_value_t = 540)]
     size: usize,
@@ -34,7 +34,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let _timer = JobTimer::start("synth");
-    let model = BodyModel::from_spec(&args.model, None)?;
+    let model = BodyModel::from_spec(&args.body, None)?;
     let options = SynthOptions {
         seed: args.seed,
         size: args.size,
@@ -46,7 +46,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let progress = bar(options.total_frames() as u64, "synth");
     let summary = generate(&model, &args.out, &options, &|| progress.inc(1))?;
     progress.finish_and_clear();
-    println!(
+    tracing::info!(
         "wrote {} ({:?}, {} vertices): {} capture frames, {} novel-view and {} novel-pose frames",
         args.out.display(),
         summary.subject.outfit,

@@ -19,11 +19,11 @@ pub struct Args {
     /// Dataset folder (PeopleSnapshot layout, or `mannequin synth` output).
     #[arg(long)]
     pub data: PathBuf,
-    /// Model folder to write (avatar.json, avatar.npz, checkpoint.npz).
+    /// Avatar folder to write (avatar.json, avatar.npz, checkpoint.npz).
     #[arg(long)]
     pub out: PathBuf,
-    /// Gaussian binding: tavatar (default) or ihuman.
-    #[arg(long, default_value = "tavatar")]
+    /// Gaussian binding.
+    #[arg(long, value_enum, default_value_t = Method::Tavatar)]
     pub method: Method,
     #[arg(long, default_value_t = 2000)]
     pub iters: usize,
@@ -31,7 +31,7 @@ pub struct Args {
     pub seed: u64,
     /// Body model the dataset's poses drive: default, default-lod1, or an SMPL-family .npz.
     #[arg(long, default_value = "default")]
-    pub model: String,
+    pub body: String,
     /// Midpoint subdivisions of the body template (each quadruples the faces).
     #[arg(long, default_value_t = 0)]
     pub subdivide: usize,
@@ -60,7 +60,7 @@ pub struct Args {
     pub dilation: f64,
     /// Skirt layer over the body: auto (where the masks fill the gap between the legs below
     /// mid-thigh) or off.
-    #[arg(long, default_value = "auto")]
+    #[arg(long, value_enum, default_value_t = SkirtMode::Auto)]
     pub skirt: SkirtMode,
     /// Start over even if the model folder holds a checkpoint.
     #[arg(long)]
@@ -103,11 +103,11 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
     }
     let dataset = Dataset::open(&args.data, args.downscale)?;
     let split = dataset.split("train")?;
-    let model = BodyModel::from_spec(&args.model, None)?;
+    let model = BodyModel::from_spec(&args.body, None)?;
     if model.num_joints() != 24 {
         bail!(
             "{}: the dataset's poses are SMPL's 24 joints, but this body model has {}",
-            args.model,
+            args.body,
             model.num_joints()
         );
     }

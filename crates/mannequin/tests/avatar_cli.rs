@@ -47,7 +47,7 @@ fn model() -> &'static Path {
             "10",
             "--train",
             "8",
-            "--model",
+            "--body",
             "default-lod1",
             "--out",
             s(&data),
@@ -62,7 +62,7 @@ fn model() -> &'static Path {
             "3",
             "--checkpoint-every",
             "3",
-            "--model",
+            "--body",
             "default-lod1",
         ]));
         ok(mannequin(&["motion", "walk", "--seconds", "1", "-o", s(&dir.join("walk.npz"))]));
@@ -120,7 +120,7 @@ fn export_writes_meshes_glb_and_splats() {
 
     // Canonical OBJ: V_s itself, with a colour per vertex.
     let obj = out.join("canonical.obj");
-    ok(mannequin(&["export", "--model", s(model()), "-o", s(&obj)]));
+    ok(mannequin(&["export", "--avatar", s(model()), "-o", s(&obj)]));
     let mesh = mannequin_mesh::obj::read_obj(&obj).unwrap();
     assert_eq!(mesh.vertex_count(), v);
     let canonical = avatar.pose(&[0.0; 72], [0.0; 3]).unwrap();
@@ -133,14 +133,14 @@ fn export_writes_meshes_glb_and_splats() {
 
     // Posed PLY at a named pose.
     let ply = out.join("squat.ply");
-    ok(mannequin(&["export", "--model", s(model()), "--named", "squat", "-o", s(&ply)]));
+    ok(mannequin(&["export", "--avatar", s(model()), "--named-pose", "squat", "-o", s(&ply)]));
     let posed_mesh = mannequin_mesh::ply::read(&ply).unwrap().mesh;
     let squat = avatar.pose_mesh(&named_pose("squat").unwrap(), [0.0; 3]).unwrap();
     close(&posed_mesh.positions.concat(), &squat.concat(), 1e-5, "squat vertices");
 
     // Skinned glTF.
     let glb = out.join("avatar.glb");
-    ok(mannequin(&["export", "--model", s(model()), "-o", s(&glb)]));
+    ok(mannequin(&["export", "--avatar", s(model()), "-o", s(&glb)]));
     assert_eq!(&std::fs::read(&glb).unwrap()[..4], b"glTF");
     validate_gltf(&glb);
 
@@ -148,7 +148,7 @@ fn export_writes_meshes_glb_and_splats() {
     let splats = out.join("splats.ply");
     ok(mannequin(&[
         "export",
-        "--model",
+        "--avatar",
         s(model()),
         "--motion",
         s(&walk()),
@@ -192,7 +192,7 @@ fn export_writes_meshes_glb_and_splats() {
     ]));
     ok(mannequin(&[
         "render",
-        "--model",
+        "--avatar",
         s(model()),
         "--motion",
         s(&walk()),
@@ -278,6 +278,15 @@ fn animate_renders_frames_and_video() {
     std::fs::remove_dir_all(out).unwrap();
 }
 
+/// A usage error from clap: exit code 2, before any work, naming each of `needles`.
+fn usage_error(o: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "'{n}' not in: {err}");
+    }
+}
+
 fn one_line_error(o: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
@@ -294,34 +303,134 @@ fn bad_inputs_give_one_line_errors() {
     let out = scratch("bad");
     let missing = out.join("no_such_model");
     let obj = out.join("x.obj");
-    one_line_error(&mannequin(&["export", "--model", s(&missing), "-o", s(&obj)]), &["no_such_model"]);
+    one_line_error(&mannequin(&["export", "--avatar", s(&missing), "-o", s(&obj)]), &["no_such_model"]);
     one_line_error(
         &mannequin(&["animate", "--avatar", s(&missing), "--motion", s(&walk()), "-o", s(&out)]),
         &["no_such_model"],
     );
     one_line_error(
-        &mannequin(&["export", "--model", s(model()), "--named", "cartwheel", "-o", s(&obj)]),
-        &["cartwheel"],
-    );
-    one_line_error(
-        &mannequin(&["export", "--model", s(model()), "--named", "squat", "-o", s(&out.join("a.glb"))]),
+        &mannequin(&["export", "--avatar", s(model()), "--named-pose", "squat", "-o", s(&out.join("a.glb"))]),
         &["a.glb", "bind pose"],
     );
-    one_line_error(&mannequin(&["export", "--model", s(model()), "-o", s(&out.join("a.fbx"))]), &["a.fbx"]);
+    one_line_error(&mannequin(&["export", "--avatar", s(model()), "-o", s(&out.join("a.fbx"))]), &["a.fbx"]);
+    one_line_error(
+        &mannequin(&["export", "--avatar", s(model()), "--frame", "3", "-o", s(&obj)]),
+        &["--frame", "--motion"],
+    );
     assert!(!obj.exists());
-    // Avatar and body modes are exclusive, as clap reports usage errors (exit code 2).
-    let o = mannequin(&[
-        "animate",
+    // Enumerated flags fail at once, before any file is read, and list the choices.
+    usage_error(
+        &mannequin(&["export", "--avatar", s(&missing), "--named-pose", "cartwheel", "-o", s(&obj)]),
+        &["cartwheel", "t-pose", "arms-crossed"],
+    );
+    usage_error(
+        &mannequin(&["render", "--avatar", s(&missing), "--what", "colour", "-o", s(&obj)]),
+        &["colour", "rgb", "normals", "alpha", "depth"],
+    );
+    usage_error(
+        &mannequin(&[
+            "animate",
+            "--avatar",
+            s(&missing),
+            "--motion",
+            s(&walk()),
+            "--what",
+            "x",
+            "-o",
+            s(&out),
+        ]),
+        &["rgb", "normals"],
+    );
+    // A body model is --body and a trained avatar --avatar, on every verb.
+    usage_error(
+        &mannequin(&["animate", "--model", "default", "--motion", s(&walk()), "-o", s(&out)]),
+        &["--model"],
+    );
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// `eval --json` as a value.
+fn scores(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn eval_scores_each_test_set_afresh_in_one_layout() {
+    let out = scratch("eval");
+    let data = model().parent().unwrap().join("data");
+    // A stale prediction left in the avatar's eval folder by an earlier run is removed.
+    let stale = model().join("eval/novel_view/images/image_0099.png");
+    std::fs::create_dir_all(stale.parent().unwrap()).unwrap();
+    std::fs::write(&stale, b"stale").unwrap();
+    let json = out.join("avatar.json");
+    let o = ok(mannequin(&[
+        "eval",
         "--avatar",
         s(model()),
-        "--model",
-        "default",
-        "--motion",
-        s(&walk()),
-        "-o",
-        s(&out),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
+        "--data",
+        s(&data),
+        "--samples",
+        "2000",
+        "--json",
+        s(&json),
+    ]));
+    assert!(!stale.exists(), "stale prediction left in place");
+    let v = scores(&json);
+    let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
+    assert_eq!(keys, ["geometry", "novel_pose", "novel_view", "test"], "{v}");
+    // synth's test sets: 6 novel-view and 2 novel-pose frames at this size; no same-camera set.
+    assert!(v["test"].is_null(), "{v}");
+    assert_eq!(
+        v["novel_view"]["frames"].as_u64(),
+        Some(mannequin_data::Dataset::open(data.join("test/novel_view"), 1).unwrap().frame_count as u64)
+    );
+    assert!(v["geometry"]["chamfer_cm"].as_f64().is_some_and(|c| c > 0.0));
+    // The table goes to stdout.
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(table.contains("novel_view") && table.contains("geometry:"), "{table}");
+
+    // A folder without test/ sets is scored on its own held-out frames, named `test`.
+    let own = out.join("own.json");
+    ok(mannequin(&[
+        "eval",
+        "--avatar",
+        s(model()),
+        "--data",
+        s(&data.join("test/novel_pose")),
+        "--samples",
+        "2000",
+        "--json",
+        s(&own),
+    ]));
+    let v = scores(&own);
+    assert!(v["novel_view"].is_null() && v["test"]["frames"].as_u64().is_some(), "{v}");
+
+    // Predictions against a ground truth: only the ground truth's test frames are scored (here
+    // 8 and 9 of the capture), whatever else the folder holds, in the same layout.
+    let pred = out.join("pred");
+    std::fs::create_dir_all(pred.join("images")).unwrap();
+    let gt = mannequin_data::Dataset::open(&data, 1).unwrap();
+    let test: Vec<usize> = gt.splits["test"].frames();
+    assert_eq!(test, [8, 9]);
+    for f in 0..gt.frame_count {
+        let mut img = gt.frame(f).unwrap().image;
+        if !test.contains(&f) {
+            // Frames outside the test split hold garbage that would drag the score down.
+            img.pixels.iter_mut().for_each(|p| *p = [0.0, 1.0, 0.0]);
+        }
+        img.write_png(&pred.join(format!("images/image_{f:04}.png"))).unwrap();
+    }
+    let pg = out.join("pred.json");
+    ok(mannequin(&["eval", "--pred", s(&pred), "--gt", s(&data), "--json", s(&pg)]));
+    let v = scores(&pg);
+    let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
+    assert_eq!(keys, ["geometry", "novel_pose", "novel_view", "test"], "{v}");
+    assert_eq!(v["test"]["frames"].as_u64(), Some(2), "{v}");
+    let frames: Vec<u64> =
+        v["test"]["per_frame"].as_array().unwrap().iter().map(|f| f["frame"].as_u64().unwrap()).collect();
+    assert_eq!(frames, [8, 9]);
+    // A missing prediction for a test frame is an error naming it, not a skipped frame.
+    std::fs::remove_file(pred.join("images/image_0009.png")).unwrap();
+    one_line_error(&mannequin(&["eval", "--pred", s(&pred), "--gt", s(&data)]), &["image_0009.png"]);
     std::fs::remove_dir_all(out).unwrap();
 }
