@@ -102,7 +102,8 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     s / n as f64
 }
 
-fn mean_of(frames: &[FrameScores], get: impl Fn(&FrameScores) -> Option<f64>) -> Option<f64> {
+/// The mean of a metric over the frames that have it (`None` when none has).
+pub(crate) fn mean_of(frames: &[FrameScores], get: impl Fn(&FrameScores) -> Option<f64>) -> Option<f64> {
     let v: Vec<f64> = frames.iter().filter_map(get).collect();
     (!v.is_empty()).then(|| mean(v.into_iter()))
 }

@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::evaluation::{EvalSummary, FrameScores};
+use crate::evaluation::{EvalSummary, FrameScores, mean_of};
 
 /// What a test set holds, named for what it tests.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -48,21 +48,16 @@ pub struct Scores {
     pub geometry: GeometryScores,
 }
 
-fn mean(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
-    let v: Vec<f64> = values.flatten().collect();
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-}
-
 impl Scores {
     /// Gathers the sets' summaries; a set given twice keeps the last.
     pub fn new(sets: Vec<(TestSet, EvalSummary)>) -> Self {
-        let all: Vec<&FrameScores> = sets.iter().flat_map(|(_, s)| &s.per_frame).collect();
+        let all: Vec<FrameScores> = sets.iter().flat_map(|(_, s)| s.per_frame.iter().cloned()).collect();
         let geometry = GeometryScores {
-            chamfer_cm: mean(all.iter().map(|s| s.chamfer_cm)),
-            p2s_cm: mean(all.iter().map(|s| s.p2s_cm)),
-            normal_consistency: mean(all.iter().map(|s| s.normal_consistency)),
-            normal_angle_deg: mean(all.iter().map(|s| s.normal_angle_deg)),
-            normal_mse_x1e3: mean(all.iter().map(|s| s.normal_mse_x1e3)),
+            chamfer_cm: mean_of(&all, |s| s.chamfer_cm),
+            p2s_cm: mean_of(&all, |s| s.p2s_cm),
+            normal_consistency: mean_of(&all, |s| s.normal_consistency),
+            normal_angle_deg: mean_of(&all, |s| s.normal_angle_deg),
+            normal_mse_x1e3: mean_of(&all, |s| s.normal_mse_x1e3),
         };
         let mut scores = Self { novel_view: None, novel_pose: None, test: None, geometry };
         for (set, summary) in sets {
