@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use burn::tensor::{DType, Device, DeviceKind, Tensor, TensorData};
+use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::adam::Adam;
 use mannequin_avatar::params::Param;
 use mannequin_data::rng::SplitMix64;
@@ -137,8 +137,9 @@ fn the_first_step_moves_each_entry_by_the_learning_rate_against_its_gradient() {
     }
 }
 
+/// The kernels' GPU device; without one the test fails with `GpuUnavailable`'s one line.
 fn wgpu() -> Device {
-    Device::wgpu(DeviceKind::DefaultDevice)
+    mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]

@@ -3,14 +3,15 @@
 //! hash written out in u64 arithmetic, and central finite differences in f64. Then Flex against
 //! wgpu (lavapipe on machines without a GPU), bit-identical gradients, and bad input.
 
-use burn::tensor::{DType, Device, DeviceKind, Tensor, TensorData};
+use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::hash_grid::{
     Aabb, HashGridConfig, HashGridError, HashGridLookup, INIT_SCALE, encode, init_table, spatial_hash,
 };
 use mannequin_data::rng::SplitMix64;
 
+/// The kernels' GPU device; without one the test fails with `GpuUnavailable`'s one line.
 fn wgpu() -> Device {
-    Device::wgpu(DeviceKind::DefaultDevice)
+    mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn table_f64(v: &[f64], config: &HashGridConfig, device: &Device) -> Tensor<2> {

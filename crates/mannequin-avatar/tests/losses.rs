@@ -4,7 +4,7 @@
 //! gradients against central differences in f64, the mesh regularisers against values worked
 //! out by hand, and bad input against clear errors.
 
-use burn::tensor::{DType, Device, DeviceKind, Tensor, TensorData};
+use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::AvatarError;
 use mannequin_avatar::losses::{
     MeshTopology, gaussian_blur_valid, gaussian_window, photometric, photometric_weighted, ssim, ssim_map,
@@ -279,7 +279,7 @@ fn ssim_on_wgpu_matches_flex() {
             (value, [x, y].map(|t| values(t.grad(&grads).unwrap())))
         };
         let (v_flex, g_flex) = run(Device::flex());
-        let (v_gpu, g_gpu) = run(Device::wgpu(DeviceKind::DefaultDevice));
+        let (v_gpu, g_gpu) = run(mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}")));
         assert!((v_flex - v_gpu).abs() < 1e-5, "{name}: {v_flex} vs {v_gpu}");
         for (input, (gf, gg)) in ["pred", "target"].iter().zip(g_flex.iter().zip(&g_gpu)) {
             let scale = gf.iter().fold(0.0f64, |m, g| m.max(g.abs()));

@@ -2,13 +2,18 @@
 //! here from the glTF 2.0 specification (GLB chunks, accessors, node TRS, LINEAR samplers,
 //! inverse bind matrices), the skin is applied from the file's own data, and the result is
 //! compared with analytic poses of a 3-joint arm and with linear blend skinning computed directly
-//! from the inputs. A second test runs the Khronos glTF-Validator when it is installed.
+//! from the inputs. Two more tests run the Khronos glTF-Validator and three.js's loader on it
+//! (tools/node_checks.rs says when they are required).
 
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use mannequin_mesh::{SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh, UvLayout, write_glb};
 use serde_json::Value;
+
+#[path = "../../../tools/node_checks.rs"]
+mod node_checks;
+use node_checks::{KHRONOS_VALIDATOR, THREE_JS};
 
 const RING: [[f32; 2]; 4] = [[0.1, 0.1], [-0.1, 0.1], [-0.1, -0.1], [0.1, -0.1]];
 const RING_X: [f32; 5] = [0.0, 0.5, 1.0, 1.5, 2.0];
@@ -437,42 +442,54 @@ fn many_joints_use_u16_indices_and_stay_normalised() {
     }
 }
 
-/// Runs the Khronos validator (tools/gltf_validate.mjs) on the arm and the 300-joint export.
-/// Without the validator installed this test says so and passes, unless
-/// MANNEQUIN_REQUIRE_GLTF_VALIDATOR=1 (as in CI).
+/// The Khronos validator (tools/gltf_validate.mjs) on the arm and the 300-joint export.
 #[test]
 fn khronos_validator_reports_no_errors() {
-    let dir = std::env::var_os("GLTF_VALIDATOR_DIR").map(PathBuf::from).unwrap_or_else(|| {
-        PathBuf::from(std::env::var_os("HOME").unwrap_or_default())
-            .join(".cache/gltf-validator/node_modules/gltf-validator")
-    });
-    let node_ok =
-        std::process::Command::new("node").arg("--version").output().is_ok_and(|o| o.status.success());
-    if !(dir.join("package.json").exists() && node_ok) {
-        let message = format!(
-            "glTF validator not found at {} (or node missing); install with: \
-             npm install --prefix \"$HOME/.cache/gltf-validator\" gltf-validator",
-            dir.display()
-        );
-        assert!(std::env::var("MANNEQUIN_REQUIRE_GLTF_VALIDATOR").as_deref() != Ok("1"), "{message}");
-        eprintln!("SKIPPED: {message}");
-        return;
-    }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf_validate.mjs");
     let (many, many_motion) = many_joints();
     for (name, skinned, animation) in [("arm.glb", arm(), motion()), ("many.glb", many, many_motion)] {
         let path = temp_file(&format!("validate-{name}"));
         write_glb(&path, &skinned, Some(&animation)).unwrap();
-        let out = std::process::Command::new("node")
-            .arg(&script)
-            .arg(&path)
-            .env("GLTF_VALIDATOR_DIR", &dir)
-            .output()
-            .unwrap();
+        let report = KHRONOS_VALIDATOR.run(&path);
         std::fs::remove_file(&path).unwrap();
-        let report = String::from_utf8_lossy(&out.stdout);
-        eprintln!("{report}{}", String::from_utf8_lossy(&out.stderr));
-        assert!(out.status.success(), "{name}: validator reported errors:\n{report}");
+        let Some(report) = report else { return };
         assert!(report.contains(" 0 errors, 0 warnings"), "{name}: {report}");
+    }
+}
+
+/// three.js's loader (tools/gltf_three_check.mjs), as a web viewer plays the arm: one skinned
+/// mesh with the 3 bones, one clip, and the posed bounding boxes of the analytic poses at the
+/// first key, the second (t = d/3) and the last.
+#[test]
+fn three_js_plays_the_arm_as_posed_by_hand() {
+    let (arm, motion) = (arm(), motion());
+    let path = temp_file("three-arm.glb");
+    write_glb(&path, &arm, Some(&motion)).unwrap();
+    let report = THREE_JS.run(&path);
+    std::fs::remove_file(&path).unwrap();
+    let Some(report) = report else { return };
+    assert!(report.contains(": 1 skinned mesh(es), 1 animation(s)"), "{report}");
+    assert!(report.contains(" 3 bones,"), "{report}");
+    let boxes: Vec<[f32; 6]> = report
+        .lines()
+        .filter_map(|line| line.trim().strip_prefix("posed box at t="))
+        .map(|line| {
+            let numbers: Vec<f32> = line
+                .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+                .filter_map(|w| w.parse().ok())
+                .collect();
+            numbers[1..].try_into().unwrap_or_else(|_| panic!("a box in '{line}'"))
+        })
+        .collect();
+    assert_eq!(boxes.len(), 3, "{report}");
+    for (frame, got) in [0, 1, 3].into_iter().zip(boxes) {
+        let posed: Vec<Vec3> = arm.mesh.positions.iter().map(|&p| Vec3::from(analytic(frame, p))).collect();
+        let min = posed.iter().fold(Vec3::INFINITY, |m, &p| m.min(p));
+        let max = posed.iter().fold(Vec3::NEG_INFINITY, |m, &p| m.max(p));
+        let want = [min.x, min.y, min.z, max.x, max.y, max.z];
+        // The script prints four decimals.
+        assert!(
+            got.iter().zip(want).all(|(g, w)| (g - w).abs() < 2e-4),
+            "frame {frame}: {got:?} vs {want:?}"
+        );
     }
 }

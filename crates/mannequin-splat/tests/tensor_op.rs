@@ -3,15 +3,16 @@
 
 mod common;
 
-use burn::tensor::{Device, DeviceKind, Tensor, TensorData};
+use burn::tensor::{Device, Tensor, TensorData};
 use common::{ColorForm, RotForm, Scene, camera};
 use mannequin_splat::{
-    Camera, ColorTensor, OutputGrads, RenderOptions, RotationTensor, SplatError, backward, render,
-    splat_render,
+    Camera, ColorTensor, OutputGrads, RenderOptions, RotationTensor, SplatError, backward, gpu_device,
+    render, splat_render,
 };
 
 fn devices() -> Vec<(&'static str, Device)> {
-    vec![("flex", Device::flex()), ("wgpu", Device::wgpu(DeviceKind::DefaultDevice))]
+    let gpu = gpu_device().unwrap_or_else(|e| panic!("{e}"));
+    vec![("flex", Device::flex()), ("wgpu", gpu)]
 }
 
 fn tensor<const D: usize>(v: &[f32], shape: [usize; D], device: &Device) -> Tensor<D> {
@@ -327,4 +328,26 @@ fn non_finite_gaussians_are_skipped_and_counted_on_every_backend() {
         let clean = render_with(&h.features);
         assert_eq!(values(clean.skipped), [4.0], "{name}: skipped with finite features");
     }
+}
+
+/// With the Vulkan driver hidden from the loader, a GPU test fails with `GpuUnavailable`'s one line
+/// instead of wgpu falling back to OpenGL and panicking on the kernels' WGSL. The test runs in a
+/// child process, as wgpu's runtime comes up once per process.
+#[cfg(target_os = "linux")]
+#[test]
+fn without_a_vulkan_driver_gpu_tests_fail_with_one_line() {
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", "an_empty_scene_renders_the_background_on_every_backend"])
+        // The loader's variable since 1.3.207, and the one before it.
+        .env("VK_DRIVER_FILES", "/nonexistent")
+        .env("VK_ICD_FILENAMES", "/nonexistent")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout) + String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{text}");
+    assert!(
+        text.contains("no GPU for the wgpu kernels (no Vulkan adapter): install a Vulkan driver"),
+        "{text}"
+    );
+    assert!(!text.contains("WGSL") && !text.contains("Shader validation"), "{text}");
 }

@@ -10,6 +10,10 @@ use mannequin_avatar::Avatar;
 use mannequin_body::named_pose;
 use mannequin_splat::SplatScene;
 
+#[path = "../../../tools/node_checks.rs"]
+mod node_checks;
+use node_checks::KHRONOS_VALIDATOR;
+
 fn mannequin(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap()
 }
@@ -92,26 +96,6 @@ fn png_size(path: &Path) -> (u32, u32) {
     (be(16), be(20))
 }
 
-/// Runs the Khronos validator (tools/gltf_validate.mjs) as crates/mannequin-mesh's glTF tests
-/// do; without it installed this says so and passes, unless MANNEQUIN_REQUIRE_GLTF_VALIDATOR=1.
-fn validate_gltf(path: &Path) {
-    let dir = std::env::var_os("GLTF_VALIDATOR_DIR").map(PathBuf::from).unwrap_or_else(|| {
-        PathBuf::from(std::env::var_os("HOME").unwrap_or_default())
-            .join(".cache/gltf-validator/node_modules/gltf-validator")
-    });
-    let node_ok = Command::new("node").arg("--version").output().is_ok_and(|o| o.status.success());
-    if !(dir.join("package.json").exists() && node_ok) {
-        let message = format!("glTF validator not found at {} (or node missing)", dir.display());
-        assert!(std::env::var("MANNEQUIN_REQUIRE_GLTF_VALIDATOR").as_deref() != Ok("1"), "{message}");
-        eprintln!("SKIPPED: {message}");
-        return;
-    }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/gltf_validate.mjs");
-    let out = Command::new("node").arg(&script).arg(path).env("GLTF_VALIDATOR_DIR", &dir).output().unwrap();
-    let report = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success() && report.contains(" 0 errors"), "validator:\n{report}");
-}
-
 #[test]
 fn export_writes_meshes_glb_and_splats() {
     let out = scratch("export");
@@ -142,7 +126,9 @@ fn export_writes_meshes_glb_and_splats() {
     let glb = out.join("avatar.glb");
     ok(mannequin(&["export", "--avatar", s(model()), "-o", s(&glb)]));
     assert_eq!(&std::fs::read(&glb).unwrap()[..4], b"glTF");
-    validate_gltf(&glb);
+    if let Some(report) = KHRONOS_VALIDATOR.run(&glb) {
+        assert!(report.contains(" 0 errors"), "validator:\n{report}");
+    }
 
     // 3DGS splats at a motion frame: the avatar's posed Gaussians.
     let splats = out.join("splats.ply");

@@ -228,16 +228,21 @@ impl SplatBackend for CubeBackend {
     }
 }
 
-/// Device buffers for the kernels' unit tests, on wgpu (lavapipe on machines without a GPU).
+/// Device buffers for the kernels' unit tests, on [`crate::gpu_device`].
 #[cfg(test)]
 pub(super) mod testing {
+    use burn::backend::DispatchDevice;
     use burn::backend::ops::FloatTensorOps;
-    use burn::backend::wgpu::{CubeBackend, CubeTensor, WgpuDevice};
+    use burn::backend::wgpu::{CubeBackend, CubeTensor};
     use burn::tensor::TensorData;
     use burn_cubecl::CubeDevice;
 
+    /// The kernels' device, or a panic whose message is [`crate::GpuUnavailable`]'s one line.
     pub fn device() -> CubeDevice {
-        CubeDevice::Wgpu(WgpuDevice::default())
+        match crate::gpu_device().unwrap_or_else(|e| panic!("{e}")).as_dispatch() {
+            DispatchDevice::Cube(device) => device.clone(),
+            other => unreachable!("gpu_device gives a wgpu device, not {other:?}"),
+        }
     }
 
     pub fn floats(v: &[f32], shape: Vec<usize>, device: &CubeDevice) -> CubeTensor {
