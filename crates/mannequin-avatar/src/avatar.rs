@@ -6,7 +6,7 @@ use std::path::Path;
 
 use burn::tensor::{Device, Tensor};
 use mannequin_body::{Rig, skin_tensors};
-use mannequin_io::{Npz, NpzWriter, write_atomic};
+use mannequin_io::{NpyArray, Npz, NpzWriter, write_atomic};
 use mannequin_splat::{Camera, ColorTensor, RenderOptions, RotationTensor, sh, splat_render};
 
 use crate::canonical::Canonical;
@@ -33,6 +33,8 @@ pub const COLOUR_LR: f64 = 1e-2;
 /// File names inside a model directory.
 pub const CONFIG_FILE: &str = "avatar.json";
 pub const PARAMS_FILE: &str = "avatar.npz";
+/// The member of `avatar.npz` that holds the configuration.
+const CONFIG_MEMBER: &str = "config";
 
 /// The learned parts that are not fields, by index into `Avatar::params`.
 #[derive(Clone, Debug, Default)]
@@ -393,32 +395,44 @@ impl Avatar {
         Ok(Rendered { image: out.image, alpha: out.alpha, depth: out.depth })
     }
 
-    /// Writes `avatar.json` and `avatar.npz` (canonical body + parameters) into `dir`, each
-    /// atomically.
+    /// Writes the model directory `dir`. `avatar.npz` holds everything [`Avatar::load`] reads,
+    /// the configuration included (as JSON text), so one atomic rename replaces the whole model
+    /// and a crash never pairs a new configuration with old parameters. `avatar.json` is a
+    /// copy for people, written after it; a crash between the two leaves only that copy stale.
     pub fn save(&self, dir: &Path) -> Result<(), AvatarError> {
         std::fs::create_dir_all(dir).map_err(|e| AvatarError::file(dir, e.to_string()))?;
         let json = serde_json::to_string_pretty(&self.config).expect("config serialises");
-        let path = dir.join(CONFIG_FILE);
-        write_atomic(&path, json.as_bytes()).map_err(|e| AvatarError::file(&path, e.to_string()))?;
         let mut w = NpzWriter::new();
+        w.add(CONFIG_MEMBER, NpyArray::text(&json));
         self.canonical.write(&mut w);
         for p in &self.params {
             p.save(&mut w, "param/");
         }
         w.write(dir.join(PARAMS_FILE))?;
+        let path = dir.join(CONFIG_FILE);
+        write_atomic(&path, json.as_bytes()).map_err(|e| AvatarError::file(&path, e.to_string()))?;
         Ok(())
     }
 
-    /// Loads a model directory written by [`Avatar::save`] onto `device`.
+    /// Loads a model directory written by [`Avatar::save`] onto `device`. Directories saved
+    /// before `avatar.npz` held the configuration are read from `avatar.json`.
     pub fn load(dir: &Path, device: &Device) -> Result<Self, AvatarError> {
-        let path = dir.join(CONFIG_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            AvatarError::file(&path, format!("{e} (is this a model directory written by `mannequin train`?)"))
-        })?;
-        let config: AvatarConfig =
-            serde_json::from_str(&text).map_err(|e| AvatarError::file(&path, e.to_string()))?;
         let npz_path = dir.join(PARAMS_FILE);
+        if !npz_path.exists() {
+            return Err(AvatarError::file(
+                &npz_path,
+                "missing (is this a model directory written by `mannequin train`?)",
+            ));
+        }
         let npz = Npz::read(&npz_path)?;
+        let config: AvatarConfig = if npz.contains(CONFIG_MEMBER) {
+            serde_json::from_str(npz.text(CONFIG_MEMBER)?)
+                .map_err(|e| npz.field_error(CONFIG_MEMBER, e.to_string()))?
+        } else {
+            let path = dir.join(CONFIG_FILE);
+            let text = std::fs::read_to_string(&path).map_err(|e| AvatarError::file(&path, e.to_string()))?;
+            serde_json::from_str(&text).map_err(|e| AvatarError::file(&path, e.to_string()))?
+        };
         let canonical = Canonical::read(&npz, &npz_path)?;
         let mut avatar = Self::new(config, canonical, device)?;
         avatar.load_params(&npz, "param/", &npz_path)?;

@@ -42,7 +42,8 @@ const EDGE: f32 = 0.015;
 const HEM_MARGIN: f32 = 0.08;
 
 /// Whether to add the layer: when the masks show a skirt, or never.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum SkirtMode {
     Auto,
     Off,

@@ -13,6 +13,7 @@ use crate::avatar::Avatar;
 use crate::config::Method;
 use crate::error::AvatarError;
 use crate::losses::{MeshTopology, photometric_weighted};
+use crate::run::TrainingRun;
 use crate::views::View;
 
 /// Where Tavatar's learning rates end, as a fraction of their start. Constant rates leave the
@@ -29,8 +30,10 @@ pub const FINAL_LR_FACTOR: f64 = 0.1;
 pub const HALF_RESOLUTION_SHARE: f64 = 0.5;
 
 /// Loss weights and switches.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TrainOptions {
+    /// Named in a run's record as `train --iters` names it.
+    #[serde(rename = "iters")]
     pub iterations: usize,
     pub seed: u64,
     /// λ_SSIM of Eqs. 12–13.
@@ -310,11 +313,12 @@ impl Trainer {
         Ok(total / repeats.max(1) as u32)
     }
 
-    /// Writes parameters, optimiser moments and the iteration count atomically.
-    pub fn save_checkpoint(&self, path: &Path) -> Result<(), AvatarError> {
+    /// Writes parameters, optimiser moments, the iteration count and `run`, the record of what
+    /// this trainer was built from, in one atomic file.
+    pub fn save_checkpoint(&self, path: &Path, run: &TrainingRun) -> Result<(), AvatarError> {
         let mut w = NpzWriter::uncompressed();
         w.add("iteration", NpyArray::i64(vec![1], vec![self.iteration as i64]));
-        w.add("seed", NpyArray::i64(vec![1], vec![self.options.seed as i64]));
+        run.write(&mut w);
         for p in &self.avatar.params {
             p.save(&mut w, "param/");
         }
@@ -323,20 +327,11 @@ impl Trainer {
         Ok(())
     }
 
-    /// Continues from a checkpoint written by [`Trainer::save_checkpoint`] for the same avatar
-    /// configuration and seed.
-    pub fn resume(&mut self, path: &Path) -> Result<(), AvatarError> {
+    /// Continues from a checkpoint written by [`Trainer::save_checkpoint`], refusing one whose
+    /// record differs from `run` in any setting.
+    pub fn resume(&mut self, path: &Path, run: &TrainingRun) -> Result<(), AvatarError> {
         let npz = Npz::read(path)?;
-        let (_, seed) = npz.f64_with_shape("seed", &[Some(1)])?;
-        if seed[0] as u64 != self.options.seed {
-            return Err(AvatarError::file(
-                path,
-                format!(
-                    "checkpoint was trained with seed {}, this run asks for {}",
-                    seed[0], self.options.seed
-                ),
-            ));
-        }
+        run.check(&npz, &[])?;
         let (_, it) = npz.f64_with_shape("iteration", &[Some(1)])?;
         self.avatar.load_params(&npz, "param/", path)?;
         self.adam = Adam::load(&self.avatar.params, &npz, path)?;

@@ -1,16 +1,17 @@
 //! Training as a user relies on it: a run resumed from a checkpoint ends bit-identical to an
-//! uninterrupted one, a non-finite loss stops the run naming the iteration, the loss falls on a
+//! uninterrupted one (and a run of another length is refused), a non-finite loss stops the run naming the iteration, the loss falls on a
 //! real (small) synthetic subject, and a dataset with a missing piece fails before training.
 
 use std::path::{Path, PathBuf};
 
 use burn::tensor::Device;
 use mannequin_avatar::{
-    Avatar, AvatarConfig, AvatarError, Canonical, Method, TrainOptions, Trainer, load_views,
+    Avatar, AvatarConfig, AvatarError, Canonical, Method, SkirtMode, TrainOptions, Trainer, TrainingRun,
+    load_views,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::Dataset;
 use mannequin_data::synth::{SynthOptions, generate};
+use mannequin_data::{Dataset, Fingerprint};
 
 fn subject(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mannequin-training-{name}-{}", std::process::id()));
@@ -43,6 +44,20 @@ fn trainer_with(data: &Path, method: Method, options: TrainOptions) -> Trainer {
     Trainer::new(avatar, views, options).unwrap()
 }
 
+/// What the CLI records for a trainer built by [`trainer_with`].
+fn record(t: &Trainer, data: &Path) -> TrainingRun {
+    let dataset = Dataset::open(data, 1).unwrap();
+    let split = dataset.split("train").unwrap();
+    TrainingRun {
+        body: "default-lod1".into(),
+        downscale: 1,
+        skirt: SkirtMode::Off,
+        data: Fingerprint::of(&dataset, &split).unwrap(),
+        avatar: t.avatar.config.clone(),
+        options: t.options.clone(),
+    }
+}
+
 fn parameters(t: &Trainer) -> Vec<(String, Vec<f32>)> {
     t.avatar
         .params
@@ -71,10 +86,14 @@ fn resume_matches() {
             first.step().unwrap();
         }
         let checkpoint = data.join(format!("{method:?}.npz"));
-        first.save_checkpoint(&checkpoint).unwrap();
+        first.save_checkpoint(&checkpoint, &record(&first, &data)).unwrap();
         drop(first);
+        // A run of another length is refused: its learning rates would decay differently.
+        let mut longer = trainer(&data, method, 7);
+        let e = longer.resume(&checkpoint, &record(&longer, &data)).unwrap_err().to_string();
+        assert!(e.contains("options.iters was 6, now 7"), "{e}");
         let mut resumed = trainer(&data, method, 6);
-        resumed.resume(&checkpoint).unwrap();
+        resumed.resume(&checkpoint, &record(&resumed, &data)).unwrap();
         assert_eq!(resumed.iteration, 3);
         for _ in 0..3 {
             resumed.step().unwrap();

@@ -4,6 +4,7 @@
 pub mod dataset;
 pub mod error;
 pub mod evaluation;
+pub mod fingerprint;
 pub mod image;
 pub mod layout;
 pub mod maps;
@@ -18,6 +19,7 @@ pub mod writer;
 
 pub use dataset::{Cameras, Dataset, Frame, Split};
 pub use error::DataError;
+pub use fingerprint::Fingerprint;
 pub use image::{Image, Mask};
 /// The one camera type of the project, shared with the renderer.
 pub use mannequin_splat::Camera;

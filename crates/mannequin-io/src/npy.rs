@@ -41,6 +41,12 @@ impl NpyArray {
         Self { shape, data: NpyData::I64(data) }
     }
 
+    /// One string as a 0-d array (numpy reads it back with `str(a)`): JSON and other text
+    /// stored beside the arrays it describes, so both are written in one atomic file.
+    pub fn text(s: &str) -> Self {
+        Self { shape: vec![], data: NpyData::Str(vec![s.to_string()]) }
+    }
+
     pub fn len(&self) -> usize {
         self.shape.iter().product()
     }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::atomic::write_atomic;
 use crate::error::IoError;
-use crate::npy::{NpyArray, parse_npy, write_npy};
+use crate::npy::{NpyArray, NpyData, parse_npy, write_npy};
 
 /// All arrays of one `.npz` file, decoded eagerly, with the file name kept for errors.
 #[derive(Debug, Clone)]
@@ -66,6 +66,18 @@ impl Npz {
             key: key.to_string(),
             present: self.keys().collect::<Vec<_>>().join(", "),
         })
+    }
+
+    /// The text under `key`, stored by [`NpyArray::text`].
+    pub fn text(&self, key: &str) -> Result<&str, IoError> {
+        let a = self.require(key)?;
+        match &a.data {
+            NpyData::Str(v) if v.len() == 1 => Ok(&v[0]),
+            _ => Err(self.field_error(
+                key,
+                format!("expected one string, found dtype {} shape {:?}", a.dtype_name(), a.shape),
+            )),
+        }
     }
 
     /// An error about `key` in this file.
@@ -178,6 +190,16 @@ mod tests {
         assert!(bytes.len() > 4000);
         let npz = Npz::from_bytes("mem.npz".into(), &bytes).unwrap();
         assert_eq!(npz.require("x").unwrap().to_f32().unwrap(), values);
+    }
+
+    #[test]
+    fn text_round_trips_and_a_number_is_not_text() {
+        let mut w = sample();
+        w.add("json", NpyArray::text("{\"é\": 1}"));
+        let npz = Npz::from_bytes("mem.npz".into(), &w.to_bytes()).unwrap();
+        assert_eq!(npz.text("json").unwrap(), "{\"é\": 1}");
+        let msg = npz.text("b").unwrap_err().to_string();
+        assert!(msg.contains("'b'") && msg.contains("expected one string"), "{msg}");
     }
 
     #[test]

@@ -1,16 +1,18 @@
 //! `mannequin train`: reconstruct an animatable avatar from a dataset (Tavatar by default, or
 //! iHuman), with checkpoints that a re-run of the same command resumes from.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
 use mannequin_avatar::trainer::checkpoint_path;
 use mannequin_avatar::{
-    Avatar, AvatarConfig, AvatarError, Canonical, Method, SkirtMode, TrainOptions, Trainer, load_views,
+    Avatar, AvatarConfig, AvatarError, Canonical, Method, SkirtMode, TrainOptions, Trainer, TrainingRun,
+    load_views,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::Dataset;
+use mannequin_data::{Dataset, Fingerprint};
+use mannequin_io::Npz;
 
 use crate::progress::{JobTimer, bar};
 
@@ -79,25 +81,29 @@ fn avatar_config(args: &Args) -> AvatarConfig {
     config
 }
 
-/// The saved configuration of a model folder, if there is one.
-fn saved_config(dir: &Path) -> Result<Option<AvatarConfig>> {
-    let path = dir.join(mannequin_avatar::avatar::CONFIG_FILE);
-    if !path.exists() {
-        return Ok(None);
+fn train_options(args: &Args) -> TrainOptions {
+    let mut options = TrainOptions::new(args.method, args.iters, args.seed);
+    if args.no_equilateral {
+        options.lambda_equilateral = 0.0;
     }
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    Ok(Some(serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?))
+    options
+}
+
+/// A checkpoint that cannot be resumed, with the way out.
+fn start_over(e: AvatarError) -> anyhow::Error {
+    anyhow!("{e}; use --restart to start over, or another --out")
 }
 
 /// Runs the whole job: checks the dataset, builds or resumes the avatar, trains, saves.
 pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("train");
-    let trainer = prepare(&args)?;
-    train(trainer, &args)
+    let (trainer, record) = prepare(&args)?;
+    train(trainer, &record, &args)
 }
 
-/// Everything before the first iteration: every input is checked here.
-pub fn prepare(args: &Args) -> Result<Trainer> {
+/// Everything before the first iteration: every input is checked here, and a checkpoint of
+/// another run is refused before the views load.
+pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
     if args.iters == 0 || args.checkpoint_every == 0 {
         bail!("--iters and --checkpoint-every must be at least 1");
     }
@@ -110,6 +116,28 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
             args.body,
             model.num_joints()
         );
+    }
+    let mut record = TrainingRun {
+        body: args.body.clone(),
+        downscale: args.downscale,
+        skirt: args.skirt,
+        data: Fingerprint::of(&dataset, &split)?,
+        avatar: avatar_config(args),
+        options: train_options(args),
+    };
+    let checkpoint = checkpoint_path(&args.out);
+    let resume = !args.restart && checkpoint.exists();
+    if resume {
+        // Whether a skirt layer is added is decided from the views, not loaded yet; it follows
+        // from the data, body, subdivisions and skirt mode compared here.
+        Npz::read(&checkpoint)
+            .map_err(AvatarError::from)
+            .and_then(|npz| record.check(&npz, &["avatar.skirt_layer"]))
+            .map_err(start_over)?;
+    } else if args.restart && checkpoint.exists() {
+        // Gone before anything new is written, so a restart stopped before its first
+        // checkpoint starts over again instead of resuming the old run.
+        std::fs::remove_file(&checkpoint).with_context(|| format!("removing {}", checkpoint.display()))?;
     }
     let views = {
         let progress = bar(split.frames.len() as u64, "loading");
@@ -125,28 +153,12 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
     if let Some(layer) = &skirt {
         tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
     }
-    let mut config = avatar_config(args);
-    config.skirt_layer = skirt.is_some();
-    let checkpoint = checkpoint_path(&args.out);
-    let resume = !args.restart && checkpoint.exists();
-    if resume
-        && let Some(saved) = saved_config(&args.out)?
-        && saved != config
-    {
-        bail!(
-            "{} holds a checkpoint of a different avatar configuration; use --restart to start over or another --out",
-            args.out.display()
-        );
-    }
+    record.avatar.skirt_layer = skirt.is_some();
     let device = burn::tensor::Device::flex().autodiff();
-    let avatar = Avatar::new(config, canonical, &device)?;
-    let mut options = TrainOptions::new(args.method, args.iters, args.seed);
-    if args.no_equilateral {
-        options.lambda_equilateral = 0.0;
-    }
-    let mut trainer = Trainer::new(avatar, views, options)?;
+    let avatar = Avatar::new(record.avatar.clone(), canonical, &device)?;
+    let mut trainer = Trainer::new(avatar, views, record.options.clone())?;
     if resume {
-        trainer.resume(&checkpoint)?;
+        trainer.resume(&checkpoint, &record).map_err(start_over)?;
         tracing::info!("resuming from {} at iteration {}", checkpoint.display(), trainer.iteration);
     } else {
         // The model folder is usable (loadable) from the start.
@@ -159,11 +171,11 @@ pub fn prepare(args: &Args) -> Result<Trainer> {
         trainer.num_views(),
         args.iters
     );
-    Ok(trainer)
+    Ok((trainer, record))
 }
 
 /// The training loop with its progress bar, checkpoints and final save.
-pub fn train(mut trainer: Trainer, args: &Args) -> Result<()> {
+pub fn train(mut trainer: Trainer, record: &TrainingRun, args: &Args) -> Result<()> {
     let checkpoint = checkpoint_path(&args.out);
     let progress = bar(args.iters as u64, "training");
     progress.set_position(trainer.iteration as u64);
@@ -183,7 +195,7 @@ pub fn train(mut trainer: Trainer, args: &Args) -> Result<()> {
         progress.set_position(stats.iteration as u64);
         progress.set_message(format!("loss {:.4} psnr {p:.1}", stats.loss));
         if stats.iteration % args.checkpoint_every == 0 || stats.iteration == args.iters {
-            trainer.save_checkpoint(&checkpoint)?;
+            trainer.save_checkpoint(&checkpoint, record)?;
             if progress.is_hidden() {
                 // No terminal: keep a log line per checkpoint instead of the bar.
                 tracing::info!(

@@ -1,0 +1,172 @@
+//! `train` checkpoints as a user meets them, on a tiny synthetic subject: a run killed mid-way
+//! and started again ends bit-identical to an uninterrupted one, a resume with other settings is
+//! refused in one line before any training, and `--restart` drops the old checkpoint at once.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::OnceLock;
+
+use mannequin_io::{NpyData, Npz};
+
+/// One thread: the claim is about checkpoints, and rayon's adaptive splitting may reorder float
+/// reductions between runs on a loaded machine.
+fn command(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_mannequin"));
+    c.args(args).env("RAYON_NUM_THREADS", "1").env_remove("RUST_LOG");
+    c
+}
+
+fn ok(o: Output) -> Output {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Scratch folder `name`, emptied.
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("train-resume-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// One synthetic subject for every test.
+fn data() -> &'static Path {
+    static DATA: OnceLock<PathBuf> = OnceLock::new();
+    DATA.get_or_init(|| {
+        let data = scratch("data").join("subject");
+        let args = ["synth", "--seed", "3", "--size", "64", "--supersample", "1", "--frames", "10"];
+        let more = ["--train", "8", "--body", "default-lod1", "--out", s(&data)];
+        ok(command(&[&args[..], &more[..]].concat()).output().unwrap());
+        data
+    })
+}
+
+/// `train` on the shared subject into `out`, with `extra` flags.
+fn train(out: &Path, extra: &[&str]) -> Command {
+    let base = ["train", "--data", s(data()), "--out", s(out), "--body", "default-lod1"];
+    command(&[&base[..], extra].concat())
+}
+
+/// The iteration a model folder's checkpoint holds, if it has a readable one.
+fn checkpoint_iteration(out: &Path) -> Option<i64> {
+    let npz = Npz::read(out.join("checkpoint.npz")).ok()?;
+    Some(npz.get("iteration")?.to_i64()?[0])
+}
+
+/// A training process, killed if a test fails while it runs.
+struct Running(Child);
+
+impl Running {
+    fn start(mut c: Command, log: &Path) -> Self {
+        let log = std::fs::File::create(log).unwrap();
+        Self(c.stdout(Stdio::null()).stderr(log).spawn().unwrap())
+    }
+
+    /// Waits until `ready` holds, failing if the process ends first; then kills it (SIGKILL).
+    fn kill_when(mut self, log: &Path, ready: impl Fn() -> bool) {
+        while !ready() {
+            if let Some(status) = self.0.try_wait().unwrap() {
+                panic!("train ended ({status}) too soon: {}", std::fs::read_to_string(log).unwrap());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        self.0.kill().unwrap();
+        self.0.wait().unwrap();
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Every learned array of a model folder, as raw bits.
+fn parameters(out: &Path) -> Vec<(String, Vec<u32>)> {
+    let npz = Npz::read(out.join("avatar.npz")).unwrap();
+    let params: Vec<_> = npz
+        .keys()
+        .filter(|k| k.starts_with("param/"))
+        .map(|k| match &npz.get(k).unwrap().data {
+            NpyData::F32(v) => (k.to_string(), v.iter().map(|x| x.to_bits()).collect()),
+            other => panic!("{k}: expected float32, found {other:?}"),
+        })
+        .collect();
+    assert!(!params.is_empty(), "no parameters in {}", out.display());
+    params
+}
+
+#[test]
+fn a_killed_run_resumes_to_the_uninterrupted_result_bit_for_bit() {
+    let dir = scratch("killed");
+    let (straight, killed) = (dir.join("straight"), dir.join("killed"));
+    let flags = ["--iters", "20", "--checkpoint-every", "2"];
+    ok(train(&straight, &flags).output().unwrap());
+
+    let log = dir.join("killed.log");
+    Running::start(train(&killed, &flags), &log)
+        .kill_when(&log, || checkpoint_iteration(&killed).is_some_and(|i| i >= 4));
+    let stopped_at = checkpoint_iteration(&killed).unwrap();
+    assert!((4..20).contains(&stopped_at), "the run was not cut short: checkpoint at {stopped_at}");
+
+    let resumed = ok(train(&killed, &flags).output().unwrap());
+    let log = String::from_utf8_lossy(&resumed.stderr);
+    assert!(log.contains(&format!("at iteration {stopped_at}")), "did not resume: {log}");
+    let (a, b) = (parameters(&straight), parameters(&killed));
+    assert_eq!(a.len(), b.len());
+    for ((name, x), (_, y)) in a.iter().zip(&b) {
+        assert!(x == y, "parameter {name} differs after the killed run resumed");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The one error line of a failed run.
+fn error_line(o: &Output) -> String {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    lines[0].to_string()
+}
+
+#[test]
+fn other_settings_are_refused_and_restart_drops_the_checkpoint_first() {
+    let dir = scratch("settings");
+    let out = dir.join("model");
+    let flags = ["--iters", "2", "--checkpoint-every", "1"];
+    ok(train(&out, &flags).output().unwrap());
+    let files = ["checkpoint.npz", "avatar.npz", "avatar.json"];
+    let before: Vec<Vec<u8>> = files.iter().map(|f| std::fs::read(out.join(f)).unwrap()).collect();
+
+    for (extra, named) in [
+        (&["--iters", "3"][..], "options.iters was 2, now 3"),
+        (&["--iters", "2", "--seed", "5"], "avatar.seed was 0, now 5"),
+        (&["--iters", "2", "--no-equilateral"], "options.lambda_equilateral was 0.01, now 0.0"),
+        (&["--iters", "2", "--downscale", "2"], "downscale was 1, now 2"),
+        (&["--iters", "2", "--skirt", "off"], "skirt was auto, now off"),
+        (&["--iters", "2", "--subdivide", "1"], "avatar.subdivisions was 0, now 1"),
+    ] {
+        let line = error_line(&train(&out, extra).output().unwrap());
+        for needle in [named, "checkpoint.npz", "--restart"] {
+            assert!(line.contains(needle), "'{needle}' not in: {line}");
+        }
+    }
+    // Nothing was written: the refusal came before any work.
+    for (f, bytes) in files.iter().zip(&before) {
+        assert!(&std::fs::read(out.join(f)).unwrap() == bytes, "{f} changed");
+    }
+
+    // A restart stopped before its first checkpoint has already dropped the old one, so the
+    // next plain run starts over instead of resuming the old run.
+    let log = dir.join("restart.log");
+    let restart = train(&out, &["--restart", "--iters", "1000", "--checkpoint-every", "1000"]);
+    let fresh_model = || std::fs::read(out.join("avatar.npz")).is_ok_and(|b| b != before[1]);
+    Running::start(restart, &log).kill_when(&log, fresh_model);
+    assert!(!out.join("checkpoint.npz").exists(), "--restart left the old checkpoint");
+    std::fs::remove_dir_all(dir).unwrap();
+}
