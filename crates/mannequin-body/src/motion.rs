@@ -17,6 +17,10 @@ const BODY_JOINTS: usize = 22;
 /// PeopleSnapshot files carry no frame rate; their videos were captured at 30 fps.
 pub const PEOPLE_SNAPSHOT_FPS: f32 = 30.0;
 
+/// Most output frames per input frame [`Motion::resample`] makes: far beyond any real use, and
+/// what keeps a crafted frame rate (a clip "at" 1e-30 fps) from asking for unbounded memory.
+const MAX_RESAMPLE_RATIO: f64 = 1000.0;
+
 /// A pose sequence as stored in its file (axis-angle, parent-relative).
 #[derive(Debug, Clone)]
 pub struct Motion {
@@ -40,6 +44,16 @@ fn scalar_f64(npz: &Npz, key: &str) -> Result<f64, BodyError> {
     }
 }
 
+/// A clip needs a first frame: every use of one (resampling, posing, export) starts there.
+fn check_frames(npz: &Npz, key: &str, shape: &[usize]) -> Result<(), BodyError> {
+    if shape[0] == 0 {
+        return Err(npz
+            .field_error(key, format!("expected at least one frame, found shape {shape:?}"))
+            .into());
+    }
+    Ok(())
+}
+
 fn check_finite(npz: &Npz, key: &str, values: &[f32], per_frame: usize) -> Result<(), BodyError> {
     match values.iter().position(|x| !x.is_finite()) {
         Some(i) => Err(npz
@@ -57,6 +71,7 @@ impl Motion {
     /// An AMASS clip.
     pub fn from_amass(npz: &Npz) -> Result<Self, BodyError> {
         let (shape, poses) = npz.f64_with_shape("poses", &[None, None])?;
+        check_frames(npz, "poses", &shape)?;
         let (frames, width) = (shape[0], shape[1]);
         if !width.is_multiple_of(3) || width == 0 {
             return Err(npz
@@ -105,6 +120,7 @@ impl Motion {
     /// A PeopleSnapshot `poses/anim_nerf_*.npz` file (SMPL layout, 30 fps).
     pub fn from_people_snapshot(npz: &Npz) -> Result<Self, BodyError> {
         let (shape, go) = npz.f64_with_shape("global_orient", &[None, Some(3)])?;
+        check_frames(npz, "global_orient", &shape)?;
         let frames = shape[0];
         let (_, body) = npz.f64_with_shape("body_pose", &[Some(frames), Some(69)])?;
         let (_, transl) = npz.f64_with_shape("transl", &[Some(frames), Some(3)])?;
@@ -130,8 +146,12 @@ impl Motion {
 
     /// Reads an AMASS or a PeopleSnapshot file, told apart by their keys.
     pub fn read(path: &Path) -> Result<Self, BodyError> {
-        let npz = Npz::read(path)?;
-        if npz.contains("poses") { Self::from_amass(&npz) } else { Self::from_people_snapshot(&npz) }
+        Self::from_npz(&Npz::read(path)?)
+    }
+
+    /// An AMASS or a PeopleSnapshot clip already in memory, told apart by its keys.
+    pub fn from_npz(npz: &Npz) -> Result<Self, BodyError> {
+        if npz.contains("poses") { Self::from_amass(npz) } else { Self::from_people_snapshot(npz) }
     }
 
     /// Writes the clip as an AMASS `.npz` (`poses, trans, betas, mocap_framerate, gender`).
@@ -209,7 +229,27 @@ impl Motion {
             return Err(BodyError::input("frame rate", format!("expected a positive number, found {fps}")));
         }
         let n = self.num_frames();
-        let duration = (n.saturating_sub(1)) as f64 / self.fps as f64;
+        if n == 0 || !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(BodyError::field(
+                &self.source,
+                "poses",
+                format!(
+                    "cannot resample {n} frames at {} fps: expected at least one frame at a positive rate",
+                    self.fps
+                ),
+            ));
+        }
+        let ratio = fps as f64 / self.fps as f64;
+        if ratio > MAX_RESAMPLE_RATIO {
+            return Err(BodyError::input(
+                "frame rate",
+                format!(
+                    "{fps} fps is {ratio:.0} times the clip's {} fps: expected at most {MAX_RESAMPLE_RATIO} times",
+                    self.fps
+                ),
+            ));
+        }
+        let duration = (n - 1) as f64 / self.fps as f64;
         let out_frames = (duration * fps as f64 + 1e-6).floor() as usize + 1;
         let per = 3 * self.joints;
         let mut poses = Vec::with_capacity(out_frames * per);

@@ -38,6 +38,10 @@ const CORE_KEYS: &[&str] = &[
 
 /// Reorders an `(V, 3, K)` array into component-major `[K][3V]`.
 fn component_major(values: &[f64], v: usize, k: usize) -> Vec<f32> {
+    if k == 0 {
+        // No components (a model without a shape space): nothing to reorder.
+        return Vec::new();
+    }
     let mut out = vec![0.0f32; k * 3 * v];
     for (row, chunk) in values.chunks_exact(k).enumerate() {
         for (c, &x) in chunk.iter().enumerate() {
@@ -76,6 +80,9 @@ fn parents(npz: &Npz) -> Result<Vec<Option<usize>>, BodyError> {
         return Err(npz.field_error(key, format!("expected shape (2, J), found {:?}", a.shape)).into());
     }
     let j = a.shape[1];
+    if j == 0 {
+        return Err(npz.field_error(key, "expected at least one joint, found shape (2, 0)").into());
+    }
     let ints = a.to_i64().ok_or_else(|| npz.field_error(key, "expected integers"))?;
     let ids = &ints[j..];
     if ids.iter().enumerate().any(|(k, &id)| id != k as i64) {

@@ -122,3 +122,64 @@ fn missing_frame_rate_is_named() {
     let msg = Motion::read(&path).unwrap_err().to_string();
     one_line(&msg, "nofps.npz", "mocap_framerate");
 }
+
+/// A model with no shape components or no joints is an error or a model, never a panic.
+#[test]
+fn empty_shape_space_and_empty_skeleton() {
+    let with = |key: &str, array: NpyArray| {
+        let mut w = NpzWriter::new();
+        for (k, a) in model_arrays() {
+            w.add(&k, if k == key { array.clone() } else { a });
+        }
+        parse_model(&Npz::from_bytes(format!("no_{key}.npz").into(), &w.to_bytes()).unwrap(), None)
+    };
+    let vertices = model_arrays().iter().find(|(k, _)| k == "v_template").unwrap().1.shape[0];
+    let model = with("shapedirs", NpyArray::f64(vec![vertices, 3, 0], vec![])).unwrap();
+    assert_eq!(model.num_betas(), 0);
+    let msg = with("kintree_table", NpyArray::i64(vec![2, 0], vec![])).unwrap_err().to_string();
+    one_line(&msg, "no_kintree_table.npz", "kintree_table");
+    assert!(msg.contains("at least one joint"), "{msg}");
+}
+
+/// A clip of no frames is refused where it is read, naming the file and the field, whichever
+/// layout it has; and resampling a hand-built empty clip is an error, not a panic.
+#[test]
+fn motion_of_no_frames_is_refused() {
+    let dir = Scratch::new("empty-motion");
+    let path = dir.join("empty.npz");
+    amass(&path, 72, vec![]);
+    let msg = Motion::read(&path).unwrap_err().to_string();
+    one_line(&msg, "empty.npz", "poses");
+    assert!(msg.contains("at least one frame"), "{msg}");
+    let mut w = NpzWriter::new();
+    w.add("betas", NpyArray::f32(vec![1, 10], vec![0.0; 10]))
+        .add("global_orient", NpyArray::f32(vec![0, 3], vec![]))
+        .add("body_pose", NpyArray::f32(vec![0, 69], vec![]))
+        .add("transl", NpyArray::f32(vec![0, 3], vec![]));
+    let npz = Npz::from_bytes("snap.npz".into(), &w.to_bytes()).unwrap();
+    let msg = Motion::from_npz(&npz).unwrap_err().to_string();
+    one_line(&msg, "snap.npz", "global_orient");
+    let empty = Motion {
+        source: "hand.npz".into(),
+        poses: vec![],
+        joints: 24,
+        trans: vec![],
+        betas: vec![],
+        fps: 60.0,
+        gender: None,
+    };
+    let msg = empty.resample(30.0).unwrap_err().to_string();
+    one_line(&msg, "hand.npz", "poses");
+}
+
+/// A crafted frame rate cannot make resampling ask for unbounded memory.
+#[test]
+fn resampling_far_beyond_the_clip_rate_is_refused() {
+    let dir = Scratch::new("slow-motion");
+    let path = dir.join("slow.npz");
+    amass(&path, 72, vec![0.0; 144]);
+    let mut motion = Motion::read(&path).unwrap();
+    motion.fps = 1e-30;
+    let msg = motion.resample(30.0).unwrap_err().to_string();
+    assert!(msg.contains("frame rate") && msg.contains("at most 1000 times"), "{msg}");
+}

@@ -118,6 +118,7 @@ enum Kind {
 
 struct Descr {
     kind: Kind,
+    /// Bytes per element (four per character for `U`).
     size: usize,
     big_endian: bool,
 }
@@ -145,17 +146,24 @@ fn parse_descr(descr: &str) -> Result<Descr, NpyError> {
         }
         _ => return Err(bad()),
     };
-    let size: usize = rest[1..].parse().map_err(|_| bad())?;
+    let width: usize = rest[1..].parse().map_err(|_| bad())?;
     let valid = match kind {
-        Kind::Float => matches!(size, 4 | 8),
-        Kind::Int | Kind::UInt => matches!(size, 1 | 2 | 4 | 8),
-        Kind::Bool => size == 1,
+        Kind::Float => matches!(width, 4 | 8),
+        Kind::Int | Kind::UInt => matches!(width, 1 | 2 | 4 | 8),
+        Kind::Bool => width == 1,
+        // A zero-width element would let any element count fit in no bytes at all.
+        Kind::Unicode | Kind::Bytes if width == 0 => {
+            return Err(NpyError::Format(format!(
+                "dtype '{descr}' has zero-width strings: expected a width of at least 1"
+            )));
+        }
         Kind::Unicode | Kind::Bytes => true,
     };
-    if !valid {
-        return Err(bad());
+    let size = if kind == Kind::Unicode { width.checked_mul(4) } else { Some(width) };
+    match size {
+        Some(size) if valid => Ok(Descr { kind, size, big_endian }),
+        _ => Err(bad()),
     }
-    Ok(Descr { kind, size, big_endian })
 }
 
 /// Extracts the value text after `'key':` in the header dict.
@@ -240,18 +248,18 @@ fn decode(descr: &Descr, raw: &[u8], count: usize) -> Result<NpyData, NpyError> 
                 })
                 .collect(),
         ),
-        Kind::Unicode => {
-            // 'U<n>' stores n UCS-4 code points per element.
-            let s = 4 * descr.size;
-            let strings = raw.chunks_exact(s).take(count).map(|w| {
-                w.chunks_exact(4)
-                    .map(|c| read_word(c, be) as u32)
-                    .take_while(|&c| c != 0)
-                    .map(|c| char::from_u32(c).unwrap_or('\u{fffd}'))
-                    .collect()
-            });
-            NpyData::Str(strings.collect())
-        }
+        // 'U<n>' stores n UCS-4 code points per element.
+        Kind::Unicode => NpyData::Str(
+            words
+                .map(|w| {
+                    w.chunks_exact(4)
+                        .map(|c| read_word(c, be) as u32)
+                        .take_while(|&c| c != 0)
+                        .map(|c| char::from_u32(c).unwrap_or('\u{fffd}'))
+                        .collect()
+                })
+                .collect(),
+        ),
     })
 }
 
@@ -283,40 +291,76 @@ fn fortran_to_c<T: Clone>(data: &[T], shape: &[usize]) -> Vec<T> {
     out
 }
 
-/// Parses one `.npy` file held in memory.
-pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
+/// Bytes before the header text: magic, version and header length (two bytes of length in
+/// version 1, four after). [`header_end`] needs no more.
+pub const PREFIX_LEN: usize = 12;
+
+/// Longest header accepted, as numpy's own reader (`max_header_size`): the length field is
+/// untrusted, and an archive reader must not inflate gigabytes of "header" to learn that.
+const MAX_HEADER_LEN: usize = 10_000;
+
+/// Where the header ends and the data starts, read from the file's first [`PREFIX_LEN`] bytes.
+pub fn header_end(bytes: &[u8]) -> Result<usize, NpyError> {
+    header_span(bytes).map(|span| span.end)
+}
+
+/// Where the header text lies.
+fn header_span(bytes: &[u8]) -> Result<std::ops::Range<usize>, NpyError> {
     if bytes.len() < 10 || &bytes[..6] != MAGIC {
         return Err(NpyError::Format("not an .npy array (bad magic)".into()));
     }
-    let major = bytes[6];
-    let (header_len, header_start) = match major {
-        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10usize),
-        2 | 3 => {
-            if bytes.len() < 12 {
-                return Err(NpyError::Format("truncated header".into()));
-            }
-            let len = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
-            (len, 12)
-        }
+    let (header_len, header_start) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 => match bytes.get(8..12) {
+            Some(&[a, b, c, d]) => (u32::from_le_bytes([a, b, c, d]) as usize, 12),
+            _ => return Err(NpyError::Format("truncated header".into())),
+        },
         v => return Err(NpyError::Format(format!("unsupported .npy version {v}"))),
     };
-    let header_end = header_start
-        .checked_add(header_len)
-        .filter(|&e| e <= bytes.len())
-        .ok_or_else(|| NpyError::Format("truncated header".into()))?;
-    let header = std::str::from_utf8(&bytes[header_start..header_end])
-        .map_err(|_| NpyError::Format("header is not text".into()))?;
-    let (descr, fortran, shape) = parse_header(header)?;
-    let count = shape
-        .iter()
-        .try_fold(1usize, |a, &d| a.checked_mul(d))
-        .ok_or_else(|| NpyError::Format("shape overflows".into()))?;
-    let elem = if descr.kind == Kind::Unicode { 4 * descr.size } else { descr.size };
-    let need = count.checked_mul(elem).ok_or_else(|| NpyError::Format("shape overflows".into()))?;
-    let raw = &bytes[header_end..];
-    if raw.len() < need {
+    if header_len > MAX_HEADER_LEN {
         return Err(NpyError::Format(format!(
-            "truncated data: shape {shape:?} needs {need} bytes, found {}",
+            "header of {header_len} bytes: expected at most {MAX_HEADER_LEN}, as numpy reads"
+        )));
+    }
+    Ok(header_start..header_start + header_len)
+}
+
+/// What the header says: the element type, the layout, and where the data lies.
+struct Header {
+    descr: Descr,
+    fortran: bool,
+    shape: Vec<usize>,
+    count: usize,
+    data_start: usize,
+    data_len: usize,
+}
+
+fn read_header(bytes: &[u8]) -> Result<Header, NpyError> {
+    let span = header_span(bytes)?;
+    let data_start = span.end;
+    let header = bytes.get(span).ok_or_else(|| NpyError::Format("truncated header".into()))?;
+    let header = std::str::from_utf8(header).map_err(|_| NpyError::Format("header is not text".into()))?;
+    let (descr, fortran, shape) = parse_header(header)?;
+    let overflow = || NpyError::Format(format!("shape {shape:?} overflows"));
+    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(overflow)?;
+    let data_len = count.checked_mul(descr.size).ok_or_else(overflow)?;
+    data_start.checked_add(data_len).ok_or_else(overflow)?;
+    Ok(Header { descr, fortran, shape, count, data_start, data_len })
+}
+
+/// Bytes the whole file takes, header and data, by its header's shape and dtype; `bytes` must
+/// hold the header ([`header_end`]). An archive reader refuses a member that inflates past this.
+pub fn declared_len(bytes: &[u8]) -> Result<usize, NpyError> {
+    read_header(bytes).map(|h| h.data_start + h.data_len)
+}
+
+/// Parses one `.npy` file held in memory.
+pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
+    let Header { descr, fortran, shape, count, data_start, data_len } = read_header(bytes)?;
+    let raw = &bytes[data_start.min(bytes.len())..];
+    if raw.len() < data_len {
+        return Err(NpyError::Format(format!(
+            "truncated data: shape {shape:?} needs {data_len} bytes, found {}",
             raw.len()
         )));
     }
@@ -432,6 +476,42 @@ mod tests {
         let b = numpy_f8_2x3();
         let err = parse_npy(&b[..b.len() - 3]).unwrap_err();
         assert!(err.to_string().contains("truncated"), "{err}");
+    }
+
+    /// A version-1 file with this header dict and data.
+    fn npy_with(header: &str, data: &[u8]) -> Vec<u8> {
+        let mut b = b"\x93NUMPY\x01\x00".to_vec();
+        b.extend_from_slice(&(header.len() as u16).to_le_bytes());
+        b.extend_from_slice(header.as_bytes());
+        b.extend_from_slice(data);
+        b
+    }
+
+    /// Zero-width strings would let any element count fit in no data at all.
+    #[test]
+    fn zero_width_strings_are_an_error() {
+        for descr in ["<U0", "|S0"] {
+            let b = npy_with(
+                &format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': (99999999999,), }}"),
+                &[],
+            );
+            let err = parse_npy(&b).unwrap_err().to_string();
+            assert!(err.contains(descr) && err.contains("width of at least 1"), "{err}");
+        }
+        // A width whose four bytes per character overflow is no dtype either.
+        let b = npy_with("{'descr': '<U4611686018427387904', 'fortran_order': False, 'shape': (1,), }", &[]);
+        assert!(parse_npy(&b).unwrap_err().to_string().contains("unsupported dtype"));
+    }
+
+    #[test]
+    fn declared_len_is_header_plus_data_and_long_headers_are_refused() {
+        let b = numpy_f8_2x3();
+        assert_eq!(declared_len(&b).unwrap(), b.len());
+        assert_eq!(header_end(&b[..PREFIX_LEN]).unwrap(), b.len() - 48);
+        let mut long = b"\x93NUMPY\x02\x00".to_vec();
+        long.extend_from_slice(&u32::MAX.to_le_bytes());
+        let err = header_end(&long).unwrap_err().to_string();
+        assert!(err.contains("4294967295") && err.contains("at most 10000"), "{err}");
     }
 
     #[test]

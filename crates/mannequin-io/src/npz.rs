@@ -5,8 +5,8 @@ use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
 
 use crate::atomic::write_atomic;
-use crate::error::IoError;
-use crate::npy::{NpyArray, NpyData, parse_npy, write_npy};
+use crate::error::{IoError, NpyError};
+use crate::npy::{self, NpyArray, NpyData, parse_npy, write_npy};
 
 /// All arrays of one `.npz` file, decoded eagerly, with the file name kept for errors.
 #[derive(Debug, Clone)]
@@ -29,19 +29,18 @@ impl Npz {
         let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| archive_err(e.to_string()))?;
         let mut arrays = BTreeMap::new();
         for i in 0..zip.len() {
-            let mut entry = zip.by_index(i).map_err(|e| archive_err(e.to_string()))?;
+            let entry = zip.by_index(i).map_err(|e| archive_err(e.to_string()))?;
             let name = entry.name().to_string();
             let key = name.strip_suffix(".npy").unwrap_or(&name).to_string();
-            // Reject entries that claim more than the archive could possibly inflate to,
-            // so a corrupt size field cannot trigger a huge allocation.
-            let cap = (entry.size() as usize).min(bytes.len().saturating_mul(1100).max(1 << 20));
-            let mut buf = Vec::with_capacity(cap);
-            entry.read_to_end(&mut buf).map_err(|e| archive_err(format!("entry '{name}': {e}")))?;
-            let array = parse_npy(&buf).map_err(|e| IoError::Field {
-                path: path.clone(),
-                key: key.clone(),
-                reason: e.to_string(),
-            })?;
+            let array =
+                read_member(entry, bytes.len()).and_then(|member| Ok(parse_npy(&member)?)).map_err(|e| {
+                    match e {
+                        MemberError::Inflate(e) => archive_err(format!("member '{name}': {e}")),
+                        MemberError::Npy(e) => {
+                            IoError::Field { path: path.clone(), key: key.clone(), reason: e.to_string() }
+                        }
+                    }
+                })?;
             arrays.insert(key, array);
         }
         Ok(Self { path, arrays })
@@ -99,6 +98,45 @@ impl Npz {
         })?;
         Ok((a.shape.clone(), v))
     }
+}
+
+/// Why a member could not be read: its compressed bytes, or its array's header.
+enum MemberError {
+    Inflate(std::io::Error),
+    Npy(NpyError),
+}
+
+impl From<std::io::Error> for MemberError {
+    fn from(e: std::io::Error) -> Self {
+        Self::Inflate(e)
+    }
+}
+
+impl From<NpyError> for MemberError {
+    fn from(e: NpyError) -> Self {
+        Self::Npy(e)
+    }
+}
+
+/// Inflates one member no further than its `.npy` header declares (header plus shape × dtype
+/// bytes), so a zip bomb costs only what its header admits to: the header is read first, then
+/// at most the declared length and one byte more, which is refused. Nothing is reserved by the
+/// archive's own size fields, and never more than the archive's length (all a stored member
+/// needs).
+fn read_member(mut entry: impl Read, archive_len: usize) -> Result<Vec<u8>, MemberError> {
+    let mut buf = Vec::new();
+    (&mut entry).take(npy::PREFIX_LEN as u64).read_to_end(&mut buf)?;
+    let header_end = npy::header_end(&buf)?;
+    (&mut entry).take(header_end.saturating_sub(buf.len()) as u64).read_to_end(&mut buf)?;
+    let declared = npy::declared_len(&buf)?;
+    buf.reserve(declared.min(archive_len).saturating_sub(buf.len()));
+    (&mut entry).take((declared.saturating_sub(buf.len()) as u64).saturating_add(1)).read_to_end(&mut buf)?;
+    if buf.len() > declared {
+        return Err(MemberError::Inflate(std::io::Error::other(format!(
+            "inflates past the {declared} bytes that its .npy header's shape and dtype declare"
+        ))));
+    }
+    Ok(buf)
 }
 
 fn shape_text(expected: &[Option<usize>]) -> String {
@@ -223,6 +261,24 @@ mod tests {
             let err = Npz::from_bytes("t.npz".into(), &bytes[..cut]).unwrap_err();
             assert!(err.to_string().starts_with("t.npz: "), "{err}");
         }
+    }
+
+    /// A zip bomb: a member whose header declares ten floats but whose data inflates to 8 MB is
+    /// refused, naming the file and the member, after reading no more than the header admits.
+    #[test]
+    fn member_inflating_past_its_header_is_refused() {
+        let mut npy = write_npy(&NpyArray::f32(vec![10], vec![0.0; 10]));
+        npy.resize(npy.len() + (8 << 20), 0);
+        let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+        zip.start_file("x.npy", zip::write::SimpleFileOptions::default()).unwrap();
+        zip.write_all(&npy).unwrap();
+        let bomb = zip.finish().unwrap().into_inner();
+        assert!(bomb.len() < 100_000);
+        let err = Npz::from_bytes("bomb.npz".into(), &bomb).unwrap_err().to_string();
+        assert!(
+            err.starts_with("bomb.npz: ") && err.contains("'x.npy'") && err.contains("inflates past"),
+            "{err}"
+        );
     }
 
     /// A deterministic stand-in for the fuzz target (fuzz/fuzz_targets/npz.rs) that runs in CI:

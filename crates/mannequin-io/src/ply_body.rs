@@ -1,7 +1,7 @@
 //! Sequential reading of a PLY body's values, in whichever encoding its header declares. The
 //! reader decides what the values mean; this only turns bytes or words into numbers.
 
-use crate::ply_header::{Format, PlyHeader, Scalar};
+use crate::ply_header::{Element, Format, PlyHeader, Property, Scalar};
 
 /// Why the next value could not be read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -10,6 +10,8 @@ pub enum PlyValueError {
     End,
     #[error("not a number")]
     NotANumber,
+    #[error("a count the {remaining} bytes left can hold (at most {most}), found {count}")]
+    CountTooLarge { count: usize, most: usize, remaining: usize },
 }
 
 /// A cursor over the values that follow the header.
@@ -32,6 +34,31 @@ impl<'a> PlyValues<'a> {
     /// Bytes not read yet: an upper bound on how many values can follow.
     pub fn remaining(&self) -> usize {
         self.bytes.len() - self.at
+    }
+
+    /// Refuses a record count that the bytes left cannot hold, so a reader can loop and allocate
+    /// by it: a binary value takes its size, an ASCII one a digit and a separator (none after
+    /// the file's last), and a record of no properties is counted as one byte.
+    pub fn check_count(&self, element: &Element) -> Result<(), PlyValueError> {
+        let value_len = |ty: Scalar| match self.format {
+            Format::Ascii => 2,
+            Format::Binary { .. } => ty.size(),
+        };
+        let record_len: usize = element
+            .properties
+            .iter()
+            .map(|p| match p {
+                Property::Scalar { ty, .. } => value_len(*ty),
+                Property::List { count, .. } => value_len(*count),
+            })
+            .sum();
+        let remaining = self.remaining();
+        let room = remaining + usize::from(self.format == Format::Ascii && record_len > 0);
+        let most = room / record_len.max(1);
+        if element.count > most {
+            return Err(PlyValueError::CountTooLarge { count: element.count, most, remaining });
+        }
+        Ok(())
     }
 
     /// The next value, read as type `ty` (ASCII bodies ignore the type and parse the next word).
@@ -92,5 +119,25 @@ mod tests {
             assert_eq!(v.next(Scalar::I16), Err(PlyValueError::End), "{format}: one byte left");
             assert_eq!(v.next(Scalar::U8), Ok(255.0), "{format}: a failed read consumes nothing");
         }
+    }
+
+    /// A count is checked against the bytes left before anyone loops by it; an element of no
+    /// properties counts a byte a record, so its count is bounded too.
+    #[test]
+    fn counts_beyond_the_bytes_left_are_refused() {
+        let ascii = b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+                      element junk 18446744073709551615\nend_header\n1 2\n3 4";
+        let h = PlyHeader::parse(ascii).unwrap();
+        let v = PlyValues::new(ascii, &h);
+        assert_eq!(v.check_count(&h.elements[0]), Ok(()), "no separator after the last value");
+        let err = v.check_count(&h.elements[1]).unwrap_err();
+        assert_eq!(err, PlyValueError::CountTooLarge { count: usize::MAX, most: 7, remaining: 7 });
+        assert!(err.to_string().contains("at most 7"), "{err}");
+        let binary = header("binary_little_endian", &[0; 3]);
+        let h = PlyHeader::parse(&binary).unwrap();
+        let mut two = h.elements[0].clone();
+        assert_eq!(PlyValues::new(&binary, &h).check_count(&two), Ok(()));
+        two.count = 2;
+        assert!(PlyValues::new(&binary, &h).check_count(&two).is_err(), "two shorts need 4 bytes");
     }
 }

@@ -40,11 +40,13 @@ fn bad(at: impl Into<String>, expected: impl Into<String>) -> Problem {
     Problem { at: at.into(), expected: expected.into() }
 }
 
-/// What a body value should have been, in this reader's "expected" phrasing.
-fn expected_value(e: PlyValueError) -> &'static str {
+/// What a body value (or an element's count) should have been, in this reader's "expected"
+/// phrasing.
+fn expected_value(e: PlyValueError) -> String {
     match e {
-        PlyValueError::End => "more data (the file ends early)",
-        PlyValueError::NotANumber => "a number",
+        PlyValueError::End => "more data (the file ends early)".into(),
+        PlyValueError::NotANumber => "a number".into(),
+        PlyValueError::CountTooLarge { .. } => e.to_string(),
     }
 }
 
@@ -89,12 +91,14 @@ fn parse_body(header: &PlyHeader, bytes: &[u8]) -> Result<PlyMesh, Problem> {
     let mut has_colors = false;
     let mut record = Vec::new();
     for element in &header.elements {
+        // The header's count is untrusted: past this check the file holds that many records.
+        body.check_count(element)
+            .map_err(|e| bad(format!("header, element {}", element.name), e.to_string()))?;
         let slots = if element.name == "vertex" { Some(vertex_slots(element)?) } else { None };
         if let Some(s) = &slots {
             has_normals = s.normal.iter().all(Option::is_some);
             has_colors = s.color.iter().all(Option::is_some);
-            // The header's count is untrusted: never reserve more than the file could hold.
-            positions.reserve(element.count.min(bytes.len() / 12));
+            positions.reserve(element.count);
         }
         let face_list = (element.name == "face")
             .then(|| {
@@ -297,5 +301,18 @@ mod tests {
         assert!(err.contains("idx.ply") && err.contains("vertex 9"), "{err}");
         let err = parse(Path::new("x.ply"), b"plx\n").unwrap_err().to_string();
         assert!(err.contains("magic"), "{err}");
+    }
+
+    /// An element of no properties takes no bytes a record, so its count is checked against the
+    /// file like every other: a huge one is refused at once rather than looped over.
+    #[test]
+    fn counts_the_file_cannot_hold_are_refused() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                    property float z\nelement junk 18446744073709551615\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+        let err = parse(Path::new("junk.ply"), text.as_bytes()).unwrap_err().to_string();
+        assert!(err.starts_with("junk.ply: header, element junk: ") && err.contains("at most 1"), "{err}");
+        let many = text.replace("vertex 3", "vertex 99999999999");
+        let err = parse(Path::new("v.ply"), many.as_bytes()).unwrap_err().to_string();
+        assert!(err.contains("element vertex") && err.contains("found 99999999999"), "{err}");
     }
 }

@@ -19,6 +19,9 @@ pub enum SplatError {
     /// A `.ply` file that cannot be read as 3D Gaussian splats.
     #[error("{path}: {reason}")]
     Ply { path: PathBuf, reason: String },
+    /// A camera file that cannot be read as a camera.
+    #[error("{path}: {reason}")]
+    CameraFile { path: PathBuf, reason: String },
     #[error("{path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
 }

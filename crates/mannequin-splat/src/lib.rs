@@ -29,6 +29,7 @@
 //! ```
 
 mod camera;
+pub mod camera_json;
 mod composite;
 mod composite_vjp;
 mod error;
@@ -44,6 +45,7 @@ pub mod sh;
 mod tiles;
 
 pub use camera::Camera;
+pub use camera_json::parse_camera_json;
 pub use error::SplatError;
 pub use gaussians::{Colors, GaussianGrads, Gaussians, Rotations};
 pub use gpu::{GpuUnavailable, gpu_device};

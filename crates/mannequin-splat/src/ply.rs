@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use mannequin_io::ply_header::{Element, Format, Property};
+use mannequin_io::ply_header::{Element, Property};
 use mannequin_io::{PlyHeader, PlyValues};
 
 use crate::gaussians::{Colors, Gaussians, Rotations};
@@ -104,20 +104,7 @@ impl SplatScene {
             }
         }
         let layout = Layout { index };
-        // Each record takes at least one byte per property (binary) or two characters (ASCII),
-        // so a count beyond that is a lie and must not drive allocation.
-        let min_record = match body.format() {
-            Format::Ascii => 2 * types.len(),
-            Format::Binary { .. } => types.iter().map(|t| t.size()).sum(),
-        };
-        let remaining = body.remaining();
-        if el.count.saturating_mul(min_record.max(1)) > remaining {
-            return Err(err(format!(
-                "header declares {} vertices but the file holds at most {}",
-                el.count,
-                remaining / min_record.max(1)
-            )));
-        }
+        body.check_count(el).map_err(|e| err(format!("element 'vertex': {e}")))?;
         let n_rest = (0..).take_while(|j| layout.index.contains_key(&format!("f_rest_{j}"))).count();
         let degree =
             (0..=sh::MAX_DEGREE).find(|&d| 3 * (sh::basis_len(d) - 1) == n_rest).ok_or_else(|| {
@@ -229,6 +216,7 @@ fn skip_element(
     err: &dyn Fn(String) -> SplatError,
 ) -> Result<(), SplatError> {
     let short = || err(format!("element '{}' is truncated", el.name));
+    body.check_count(el).map_err(|e| err(format!("element '{}': {e}", el.name)))?;
     for _ in 0..el.count {
         for p in &el.properties {
             match p {
@@ -338,6 +326,16 @@ mod tests {
         let m = msg(cut);
         assert!(m.contains("at most 2") || m.contains("vertex 2 of 3"), "{m}");
         std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// An element of no properties before the vertices cannot declare more records than the
+    /// file has bytes: a huge count is refused rather than skipped one empty record at a time.
+    #[test]
+    fn huge_counts_of_empty_elements_are_refused() {
+        let text = b"ply\nformat binary_little_endian 1.0\nelement junk 18446744073709551615\n\
+                     element vertex 0\nproperty float x\nend_header\n";
+        let err = SplatScene::from_ply_bytes(Path::new("e.ply"), text).unwrap_err().to_string();
+        assert!(err.starts_with("e.ply: element 'junk': ") && err.contains("at most 0"), "{err}");
     }
 
     /// A cheap in-tree stand-in for the fuzz target: truncations, byte flips and header edits of

@@ -1,26 +1,12 @@
 //! `mannequin splat render` and `mannequin splat info`: render any 3D Gaussian splatting `.ply`
 //! (INRIA layout) through a camera, or summarise one.
 //!
-//! The camera is a JSON file in the OpenCV convention (x right, y down, z forward, pixel centres
-//! at +0.5):
-//!
-//! ```json
-//! {
-//!   "width": 540, "height": 540,
-//!   "K": [[500, 0, 270], [0, 500, 270], [0, 0, 1]],
-//!   "extrinsic": [[1, 0, 0, 0], [0, -1, 0, 1], [0, 0, -1, 2.5], [0, 0, 0, 1]],
-//!   "near": 0.01, "far": 100,
-//!   "background": [1, 1, 1]
-//! }
-//! ```
-//!
-//! `K` is the 3×3 intrinsic matrix in pixels and `extrinsic` the 4×4 world→camera transform,
-//! both row-major. `near` (default 0.01), `far` (default 1e10) and `background` (RGB in
-//! `[0, 1]`, default black) are optional.
+//! The camera is a JSON file in the OpenCV convention; [`mannequin_splat::camera_json`] gives
+//! its fields.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use mannequin_splat::{Camera, RenderOptions, SplatScene, render};
 use serde_json::{Value, json};
 
@@ -68,62 +54,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// A camera JSON file, with its background colour.
 pub fn read_camera(path: &Path) -> anyhow::Result<(Camera, Vec<f64>)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-    let v: Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
-    let field = |k: &str| v.get(k).with_context(|| format!("{}: missing field '{k}'", path.display()));
-    let number = |k: &str, x: &Value| {
-        x.as_f64().with_context(|| format!("{}: field '{k}' must hold numbers, found {x}", path.display()))
-    };
-    let size = |k: &str| -> anyhow::Result<usize> {
-        let x = field(k)?;
-        x.as_u64()
-            .map(|n| n as usize)
-            .with_context(|| format!("{}: '{k}' must be a whole number, found {x}", path.display()))
-    };
-    let matrix = |k: &str, rows: usize, cols: usize| -> anyhow::Result<Vec<f64>> {
-        let m = field(k)?;
-        let bad = || format!("{}: '{k}' must be a {rows}×{cols} array of rows", path.display());
-        let rs = m.as_array().with_context(bad)?;
-        if rs.len() != rows {
-            bail!(bad());
-        }
-        let mut out = Vec::with_capacity(rows * cols);
-        for r in rs {
-            let r = r.as_array().with_context(bad)?;
-            if r.len() != cols {
-                bail!(bad());
-            }
-            for x in r {
-                out.push(number(k, x)?);
-            }
-        }
-        Ok(out)
-    };
-    let optional = |k: &str, default: f64| v.get(k).map_or(Ok(default), |x| number(k, x));
-    let (k, e) = (matrix("K", 3, 3)?, matrix("extrinsic", 4, 4)?);
-    let camera = Camera {
-        width: size("width")?,
-        height: size("height")?,
-        intrinsic: std::array::from_fn(|i| std::array::from_fn(|j| k[3 * i + j])),
-        extrinsic: std::array::from_fn(|i| std::array::from_fn(|j| e[4 * i + j])),
-        near: optional("near", 0.01)?,
-        far: optional("far", 1e10)?,
-    };
-    let background = match v.get("background") {
-        None => vec![0.0; 3],
-        Some(b) => {
-            let b = b
-                .as_array()
-                .with_context(|| format!("{}: 'background' must be [r, g, b]", path.display()))?;
-            if b.len() != 3 {
-                bail!("{}: 'background' must have 3 values, found {}", path.display(), b.len());
-            }
-            b.iter().map(|x| number("background", x)).collect::<anyhow::Result<_>>()?
-        }
-    };
-    camera.validate().with_context(|| format!("{}", path.display()))?;
-    Ok((camera, background))
+    let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
+    Ok(mannequin_splat::parse_camera_json(path, &bytes)?)
 }
 
 fn render_to_png(ply: &Path, camera: &Path, output: &Path, dilation: f64) -> anyhow::Result<()> {
@@ -238,29 +170,6 @@ mod tests {
 
     const CAMERA: &str = r#"{"width": 32, "height": 24, "K": [[30, 0, 16], [0, 30, 12], [0, 0, 1]],
         "extrinsic": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 2], [0, 0, 0, 1]], "background": [0, 0, 1]}"#;
-
-    #[test]
-    fn camera_json_is_read_and_bad_fields_are_named() {
-        let dir = temp_dir("cam");
-        let good = dir.join("good.json");
-        std::fs::write(&good, CAMERA).unwrap();
-        let (cam, bg) = read_camera(&good).unwrap();
-        assert_eq!((cam.width, cam.height, cam.near, cam.far), (32, 24, 0.01, 1e10));
-        assert_eq!(cam.extrinsic[2][3], 2.0);
-        assert_eq!(bg, vec![0.0, 0.0, 1.0]);
-        let bad = dir.join("bad.json");
-        std::fs::write(
-            &bad,
-            CAMERA.replace("[[30, 0, 16], [0, 30, 12], [0, 0, 1]]", "[[30, 0, 16], [0, 30, 12]]"),
-        )
-        .unwrap();
-        let e = format!("{:#}", read_camera(&bad).unwrap_err());
-        assert!(e.contains("bad.json") && e.contains("'K' must be a 3×3"), "{e}");
-        std::fs::write(&bad, CAMERA.replace("\"width\": 32", "\"width\": 0")).unwrap();
-        let e = format!("{:#}", read_camera(&bad).unwrap_err());
-        assert!(e.contains("empty"), "{e}");
-        std::fs::remove_dir_all(dir).unwrap();
-    }
 
     #[test]
     fn render_writes_a_png_with_the_background_where_nothing_is_drawn() {
