@@ -166,3 +166,29 @@ fn info_verbs_print_results_on_stdout_as_a_table_or_json() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("wrote"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `animate --fps` on a motion of no frames used to panic while resampling; it is a one-line
+/// error naming the file at read. (No `--model`: the default body is enough.)
+#[test]
+fn animate_refuses_a_motion_of_no_frames() {
+    use mannequin_io::{NpyArray, NpzWriter};
+    let dir = temp("empty-motion");
+    let motion = dir.join("empty.npz");
+    let mut w = NpzWriter::new();
+    w.add("poses", NpyArray::f64(vec![0, 72], vec![]))
+        .add("trans", NpyArray::f64(vec![0, 3], vec![]))
+        .add("mocap_framerate", NpyArray::f64(vec![], vec![60.0]));
+    w.write(&motion).unwrap();
+    let out = dir.join("x.glb");
+    let o = mannequin(&[
+        "animate",
+        "--motion",
+        motion.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--fps",
+        "30",
+    ]);
+    one_line_error(&o, &["empty.npz", "poses", "at least one frame"]);
+    std::fs::remove_dir_all(dir).unwrap();
+}

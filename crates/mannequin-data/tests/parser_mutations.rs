@@ -1,0 +1,312 @@
+//! Every file reader against thousands of seeded mutations of the fuzz seed corpus
+//! (`fuzz/corpus/<target>`): bit flips, byte sets, truncations, huge counts written over or into
+//! the numbers of a header, and duplicated or dropped chunks. Each case must give `Ok` or `Err`:
+//! never a panic (caught per case and reported with its seed and mutations), and never an
+//! allocation that the input does not justify (a counting allocator bounds the peak bytes live
+//! during a parse by a multiple of the input length). A hang has no timer here: the readers check
+//! every count against the bytes left before looping by it, so a regression shows as a test that
+//! never ends. The stable-toolchain stand-in for `cargo +nightly fuzz run` (see `fuzz/`); it
+//! lives in this crate because this crate depends on every reader.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::io::Write;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+use mannequin_body::{Motion, parse_model};
+use mannequin_data::rng::SplitMix64;
+use mannequin_io::Npz;
+use mannequin_io::npy::parse_npy;
+use mannequin_mesh::Obj;
+use mannequin_splat::{SplatScene, parse_camera_json};
+
+/// Counts the bytes each thread holds, so tests running side by side do not see each other.
+struct Counting;
+
+thread_local! {
+    static LIVE: Cell<usize> = const { Cell::new(0) };
+    static PEAK: Cell<usize> = const { Cell::new(0) };
+}
+
+fn grow(bytes: usize) {
+    let live = LIVE.get() + bytes;
+    LIVE.set(live);
+    PEAK.set(PEAK.get().max(live));
+}
+
+fn shrink(bytes: usize) {
+    LIVE.set(LIVE.get().saturating_sub(bytes));
+}
+
+// SAFETY: every call is forwarded to the system allocator unchanged; only counters are updated.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            grow(layout.size());
+        }
+        p
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc_zeroed(layout) };
+        if !p.is_null() {
+            grow(layout.size());
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) };
+        shrink(layout.size());
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
+        if !p.is_null() {
+            shrink(layout.size());
+            grow(new_size);
+        }
+        p
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Peak bytes live on this thread while `f` runs, above what was live before (its result
+/// included).
+fn peak_bytes<R>(f: impl FnOnce() -> R) -> (R, usize) {
+    let base = LIVE.get();
+    PEAK.set(base);
+    let r = f();
+    (r, PEAK.get() - base)
+}
+
+/// What a reader may hold for an input of `len` bytes: decoding widens values (a `uint8` index
+/// list becomes `u32` triangles, an `|S1` string a `String`), so a fixed multiple, plus a
+/// constant for the zip reader's and the JSON parser's own tables.
+fn allowance(len: usize) -> usize {
+    64 * len + (128 << 10)
+}
+
+/// Mutated cases per reader, spread evenly over its seeds.
+const CASES: usize = 40_000;
+
+/// Numbers a crafted header would declare: they must be refused before anything loops or
+/// allocates by them (2⁶² overflows once multiplied by four, as a `U` dtype's width is).
+const HUGE: [&str; 7] =
+    ["99999999999", "18446744073709551615", "4294967295", "4611686018427387904", "-1", "0", "1e308"];
+
+fn corpus(target: &str) -> Vec<(PathBuf, Vec<u8>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus").join(target);
+    let mut seeds: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|entry| {
+            let path = entry.unwrap().path();
+            let bytes = std::fs::read(&path).unwrap();
+            (path, bytes)
+        })
+        .collect();
+    seeds.sort();
+    assert!(!seeds.is_empty(), "{}: no seeds", dir.display());
+    seeds
+}
+
+/// Applies one random mutation to `b`, returning what it did for the failure report.
+fn mutate(b: &mut Vec<u8>, rng: &mut SplitMix64) -> String {
+    if b.is_empty() {
+        b.push(rng.next_u64() as u8);
+        return "push".into();
+    }
+    let at = rng.below(b.len());
+    match rng.below(8) {
+        0 => {
+            let bit = rng.below(8);
+            b[at] ^= 1 << bit;
+            format!("flip bit {bit} of byte {at}")
+        }
+        1 => {
+            let v = [0, 0xff, 0x7f, 0x80, rng.next_u64() as u8][rng.below(5)];
+            b[at] = v;
+            format!("set byte {at} to {v:#04x}")
+        }
+        2 => {
+            b.truncate(at);
+            format!("truncate to {at}")
+        }
+        3 => {
+            // Over a decimal number in the text (a PLY or .npy header count, a JSON size, an OBJ
+            // index), or anywhere when the input has none.
+            let digits: Vec<usize> = (0..b.len()).filter(|&i| b[i].is_ascii_digit()).collect();
+            let start = if digits.is_empty() { at } else { digits[rng.below(digits.len())] };
+            let end = (start..b.len()).find(|&i| !b[i].is_ascii_digit()).unwrap_or(b.len()).max(start);
+            let huge = HUGE[rng.below(HUGE.len())];
+            b.splice(start..end, huge.bytes());
+            format!("number at {start}..{end} := {huge}")
+        }
+        4 => {
+            let word: &[u8] = match rng.below(3) {
+                0 => &u32::MAX.to_le_bytes(),
+                1 => &u64::MAX.to_le_bytes(),
+                _ => &(i32::MAX as u32).to_be_bytes(),
+            };
+            let end = (at + word.len()).min(b.len());
+            b.splice(at..end, word.iter().copied());
+            format!("binary count {word:02x?} over byte {at}")
+        }
+        5 => {
+            let len = 1 + rng.below(64.min(b.len() - at));
+            let chunk = b[at..at + len].to_vec();
+            let to = rng.below(b.len() + 1);
+            b.splice(to..to, chunk);
+            format!("duplicate {at}..{} at {to}", at + len)
+        }
+        6 => {
+            let len = 1 + rng.below(16.min(b.len() - at));
+            b.drain(at..at + len);
+            format!("drop {at}..{}", at + len)
+        }
+        _ => {
+            let v = rng.next_u64() as u8;
+            b.insert(at, v);
+            format!("insert {v:#04x} at {at}")
+        }
+    }
+}
+
+/// Runs `read` on [`CASES`] mutations (one to three each) of the seeds of `target`, after checking
+/// that every seed itself reads.
+fn mutations(target: &str, read: impl Fn(&[u8]) -> Result<(), String>) {
+    let seeds = corpus(target);
+    for (path, bytes) in &seeds {
+        read(bytes).unwrap_or_else(|e| panic!("seed {} does not read: {e}", path.display()));
+    }
+    let mut ok = 0;
+    for case in 0..CASES {
+        let (path, seed) = &seeds[case % seeds.len()];
+        let mut rng = SplitMix64::new(case as u64 ^ 0x6d75_7461_7465);
+        let mut bytes = seed.clone();
+        let done: Vec<String> = (0..1 + rng.below(3)).map(|_| mutate(&mut bytes, &mut rng)).collect();
+        let report = || format!("{target} case {case}: seed {}, mutations {done:?}", path.display());
+        let (result, peak) = peak_bytes(|| catch_unwind(AssertUnwindSafe(|| read(&bytes))));
+        let result = result.unwrap_or_else(|_| panic!("{}: the reader panicked", report()));
+        assert!(
+            peak <= allowance(bytes.len()),
+            "{}: {peak} bytes live for {} bytes of input",
+            report(),
+            bytes.len()
+        );
+        ok += usize::from(result.is_ok());
+    }
+    // Some mutations must leave a readable file, or the cases never get past the first check.
+    assert!(ok > 0, "{target}: no mutated case read");
+}
+
+fn npz(bytes: &[u8]) -> Result<Npz, String> {
+    Npz::from_bytes("case.npz".into(), bytes).map_err(|e| e.to_string())
+}
+
+/// Motion and model parsing, on archives whose checksums still hold.
+fn read_motion(npz: &Npz) -> Result<(), String> {
+    let m = Motion::from_npz(npz).map_err(|e| e.to_string())?;
+    m.resample(m.fps).map_err(|e| e.to_string())?;
+    m.frame_pose(0, 24).map_err(|e| e.to_string()).map(drop)
+}
+
+#[test]
+fn npy() {
+    mutations("npy", |b| parse_npy(b).map(drop).map_err(|e| e.to_string()));
+}
+
+#[test]
+fn npz_and_body_models() {
+    mutations("npz", |b| {
+        let npz = npz(b)?;
+        if npz.contains("v_template") {
+            parse_model(&npz, None).map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    });
+}
+
+#[test]
+fn motions() {
+    mutations("motion", |b| read_motion(&npz(b)?));
+}
+
+/// Archive checksums stop most byte mutations at the zip layer; mutating one member's `.npy`
+/// bytes and storing it again, with a fresh checksum, reaches the array header parser and the
+/// motion and model readers behind it.
+#[test]
+fn npz_members_behind_valid_checksums() {
+    let repack = |seed: &[u8], member: usize, rng: &mut SplitMix64| -> Vec<u8> {
+        let mut archive = zip::ZipArchive::new(std::io::Cursor::new(seed)).unwrap();
+        let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        let stored =
+            zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+        let members = archive.len();
+        for i in 0..members {
+            let mut entry = archive.by_index(i).unwrap();
+            let mut data = Vec::new();
+            std::io::Read::read_to_end(&mut entry, &mut data).unwrap();
+            if i == member % members {
+                for _ in 0..1 + rng.below(2) {
+                    mutate(&mut data, rng);
+                }
+            }
+            out.start_file(entry.name(), stored).unwrap();
+            out.write_all(&data).unwrap();
+        }
+        out.finish().unwrap().into_inner()
+    };
+    for target in ["motion", "npz"] {
+        let seeds = corpus(target);
+        for case in 0..CASES / 2 {
+            let (path, seed) = &seeds[case % seeds.len()];
+            let mut rng = SplitMix64::new(case as u64 ^ 0x6d65_6d62);
+            let bytes = repack(seed, rng.below(16), &mut rng);
+            let report = || format!("{target} member case {case}: seed {}", path.display());
+            let (result, peak) = peak_bytes(|| {
+                catch_unwind(AssertUnwindSafe(|| {
+                    let npz = npz(&bytes)?;
+                    if npz.contains("v_template") {
+                        parse_model(&npz, None).map(drop).map_err(|e| e.to_string())
+                    } else {
+                        read_motion(&npz)
+                    }
+                }))
+            });
+            assert!(result.is_ok(), "{}: the reader panicked", report());
+            assert!(peak <= allowance(bytes.len()), "{}: {peak} bytes live for {}", report(), bytes.len());
+        }
+    }
+}
+
+#[test]
+fn mesh_ply() {
+    mutations("mesh_ply", |b| {
+        mannequin_mesh::ply::parse(Path::new("case.ply"), b).map(drop).map_err(|e| e.to_string())
+    });
+}
+
+#[test]
+fn obj() {
+    mutations("obj", |b| Obj::parse(Path::new("case.obj"), b).map(drop).map_err(|e| e.to_string()));
+}
+
+#[test]
+fn splat_ply() {
+    mutations("splat_ply", |b| {
+        let scene = SplatScene::from_ply_bytes(Path::new("case.ply"), b).map_err(|e| e.to_string())?;
+        scene.gaussians().validate_shapes().map_err(|e| e.to_string())
+    });
+}
+
+#[test]
+fn camera_json() {
+    mutations("camera_json", |b| {
+        parse_camera_json(Path::new("case.json"), b).map(drop).map_err(|e| e.to_string())
+    });
+}
