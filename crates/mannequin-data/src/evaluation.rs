@@ -133,9 +133,8 @@ fn score_frame(
     let p = Image::read_png(&pred_path)?;
     let g = Image::read_png(&gt_path)?;
     let factor = downscale_factor((p.width, p.height), (g.width, g.height), &pred_path, &gt_path)?;
-    if p.width.min(p.height) < 11 {
-        return Err(DataError::file(pred_path, "is smaller than SSIM's 11×11 window"));
-    }
+    // A metric's complaint (sizes, too small for its window) is about the prediction's file.
+    let on_pred = |e: DataError| DataError::file(&pred_path, e.to_string());
     let mask_path = layout::mask(gt, frame);
     let mask = read_mask_npy(&mask_path)?;
     if (mask.width, mask.height) != (g.width, g.height) {
@@ -148,7 +147,8 @@ fn score_frame(
     if factor > 1 {
         g = g.downscale(factor);
     }
-    let lpips = opt.lpips.as_ref().map(|m| m.distance(&p, &g)).transpose()?;
+    let (psnr, ssim) = (psnr(&p, &g).map_err(on_pred)?, ssim(&p, &g).map_err(on_pred)?);
+    let lpips = opt.lpips.as_ref().map(|m| m.distance(&p, &g)).transpose().map_err(on_pred)?;
     let (pn_path, gn_path) = (layout::normal(pred, frame), layout::normal(gt, frame));
     let normals = if pn_path.exists() && gn_path.exists() {
         let pn = NormalMap::read_png(&pn_path)?;
@@ -156,13 +156,7 @@ fn score_frame(
         if factor > 1 {
             gn = gn.downscale(factor);
         }
-        if (pn.width, pn.height) != (gn.width, gn.height) {
-            return Err(DataError::file(
-                pn_path,
-                format!("normal map is {}×{}, ground truth {}×{}", pn.width, pn.height, gn.width, gn.height),
-            ));
-        }
-        Some(normal_error(&pn, &gn))
+        Some(normal_error(&pn, &gn).map_err(|e| DataError::file(&pn_path, e.to_string()))?)
     } else {
         None
     };
@@ -177,8 +171,8 @@ fn score_frame(
     Ok((
         FrameScores {
             frame,
-            psnr: psnr(&p, &g),
-            ssim: ssim(&p, &g),
+            psnr,
+            ssim,
             lpips,
             normal_mse_x1e3: normals.map(|n| n.mse_x1e3),
             normal_angle_deg: normals.map(|n| n.angular_deg),
