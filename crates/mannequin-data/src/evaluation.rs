@@ -1,6 +1,6 @@
 //! Frame-by-frame comparison of a predicted folder with a ground-truth dataset folder.
 //!
-//! Frames are matched by image name (`images/image_NNNN.png` present in both). The ground
+//! Frames are matched by image number (`images/image_NNNN.png` or `.jpg` in both). The ground
 //! truth is composited on the stated background with its mask; the prediction is taken as
 //! rendered. Where both folders hold normal maps (`normals/`) or meshes (`meshes/`), normal and
 //! geometry metrics are added. A ground truth at an integer multiple of the prediction's size
@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::error::DataError;
+use crate::frame_files::ImageFiles;
 use crate::image::Image;
 use crate::layout;
 use crate::maps::{NormalMap, read_mask_npy};
@@ -60,32 +61,27 @@ pub struct EvalSummary {
     pub per_frame: Vec<FrameScores>,
 }
 
-/// Frame numbers of `images/image_NNNN.png` in `root`, sorted.
-fn image_frames(root: &Path) -> Result<Vec<usize>, DataError> {
-    let dir = root.join(layout::IMAGES);
-    let mut frames = Vec::new();
-    for entry in std::fs::read_dir(&dir).map_err(|e| DataError::os(&dir, e))? {
-        let entry = entry.map_err(|e| DataError::os(&dir, e))?;
-        if let Some(n) = layout::frame_number(&entry.file_name().to_string_lossy(), "image", "png") {
-            frames.push(n);
-        }
+/// The frames both folders have, in order, with each folder's image files.
+fn matching(pred: &Path, gt: &Path) -> Result<(Vec<usize>, ImageFiles, ImageFiles), DataError> {
+    let (pred_files, gt_files) = (ImageFiles::list(pred)?, ImageFiles::list(gt)?);
+    let common: Vec<usize> =
+        pred_files.frames.iter().copied().filter(|f| gt_files.frames.binary_search(f).is_ok()).collect();
+    if common.is_empty() {
+        return Err(DataError::file(
+            pred.join(layout::IMAGES),
+            format!(
+                "no image_NNNN.{} shares a frame number with {}",
+                layout::IMAGE_EXTENSIONS.join("|"),
+                gt.join(layout::IMAGES).display()
+            ),
+        ));
     }
-    frames.sort_unstable();
-    Ok(frames)
+    Ok((common, pred_files, gt_files))
 }
 
 /// The frames both folders have, in order.
 pub fn matching_frames(pred: &Path, gt: &Path) -> Result<Vec<usize>, DataError> {
-    let gt_frames = image_frames(gt)?;
-    let common: Vec<usize> =
-        image_frames(pred)?.into_iter().filter(|f| gt_frames.binary_search(f).is_ok()).collect();
-    if common.is_empty() {
-        return Err(DataError::file(
-            pred.join(layout::IMAGES),
-            format!("no image_NNNN.png shares a name with {}", gt.join(layout::IMAGES).display()),
-        ));
-    }
-    Ok(common)
+    Ok(matching(pred, gt)?.0)
 }
 
 /// The integer factor from `pred`'s size to `gt`'s, or an error naming both files.
@@ -122,16 +118,16 @@ fn mean_of(frames: &[FrameScores], get: impl Fn(&FrameScores) -> Option<f64>) ->
     (!v.is_empty()).then(|| mean(v.into_iter()))
 }
 
-/// Scores one frame.
+/// Scores one frame; `images` are the prediction's and the ground truth's image files.
 fn score_frame(
-    pred: &Path,
-    gt: &Path,
+    (pred, gt): (&Path, &Path),
+    images: &(ImageFiles, ImageFiles),
     frame: usize,
     opt: &EvalOptions,
 ) -> Result<(FrameScores, usize), DataError> {
-    let (pred_path, gt_path) = (layout::image(pred, frame), layout::image(gt, frame));
-    let p = Image::read_png(&pred_path)?;
-    let g = Image::read_png(&gt_path)?;
+    let (pred_path, gt_path) = (images.0.path(pred, frame), images.1.path(gt, frame));
+    let p = Image::read(&pred_path)?;
+    let g = Image::read(&gt_path)?;
     let factor = downscale_factor((p.width, p.height), (g.width, g.height), &pred_path, &gt_path)?;
     // A metric's complaint (sizes, too small for its window) is about the prediction's file.
     let on_pred = |e: DataError| DataError::file(&pred_path, e.to_string());
@@ -191,11 +187,12 @@ pub fn evaluate(
     opt: &EvalOptions,
     on_frame: &dyn Fn(&FrameScores),
 ) -> Result<EvalSummary, DataError> {
-    let frames = matching_frames(pred, gt)?;
+    let (frames, pred_images, gt_images) = matching(pred, gt)?;
+    let images = (pred_images, gt_images);
     let mut per_frame = Vec::with_capacity(frames.len());
     let mut gt_downscale = 1;
     for &f in &frames {
-        let (scores, factor) = score_frame(pred, gt, f, opt)?;
+        let (scores, factor) = score_frame((pred, gt), &images, f, opt)?;
         gt_downscale = factor;
         on_frame(&scores);
         per_frame.push(scores);

@@ -4,7 +4,9 @@
 pub mod dataset;
 pub mod error;
 pub mod evaluation;
+pub mod frame_files;
 pub mod image;
+pub mod image_decode;
 pub mod layout;
 pub mod maps;
 pub mod mesh_raster;

@@ -13,7 +13,7 @@ use crate::progress::{JobTimer, bar};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Folder of predictions: images/image_NNNN.png, optionally normals/ and meshes/.
+    /// Folder of predictions: images/image_NNNN.png (or .jpg), optionally normals/ and meshes/.
     #[arg(long, required_unless_present = "model", conflicts_with = "model", requires = "gt")]
     pred: Option<PathBuf>,
     /// Ground-truth dataset folder (PeopleSnapshot layout, see docs/dataset-format.md).
