@@ -144,7 +144,8 @@ fn parse_descr(descr: &str) -> Result<Descr, NpyError> {
         Kind::Float => matches!(size, 4 | 8),
         Kind::Int | Kind::UInt => matches!(size, 1 | 2 | 4 | 8),
         Kind::Bool => size == 1,
-        Kind::Unicode | Kind::Bytes => true,
+        // Zero-width strings would make every element empty and the element count unbounded.
+        Kind::Unicode | Kind::Bytes => (1..=1 << 16).contains(&size),
     };
     if !valid {
         return Err(bad());
@@ -163,7 +164,7 @@ fn header_field<'a>(header: &'a str, key: &str) -> Result<&'a str, NpyError> {
     Ok(after.trim_start())
 }
 
-fn parse_header(header: &str) -> Result<(Descr, bool, Vec<usize>), NpyError> {
+fn parse_header(header: &str) -> Result<(&str, bool, Vec<usize>), NpyError> {
     let descr_txt = header_field(header, "descr")?;
     let quote = descr_txt
         .chars()
@@ -171,7 +172,7 @@ fn parse_header(header: &str) -> Result<(Descr, bool, Vec<usize>), NpyError> {
         .filter(|c| *c == '\'' || *c == '"')
         .ok_or_else(|| NpyError::Format("structured dtypes are not supported".into()))?;
     let end = descr_txt[1..].find(quote).ok_or_else(|| NpyError::Format("unterminated 'descr'".into()))?;
-    let descr = parse_descr(&descr_txt[1..1 + end])?;
+    let descr = &descr_txt[1..1 + end];
 
     let fortran = header_field(header, "fortran_order")?.starts_with("True");
 
@@ -301,13 +302,19 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
     let header = std::str::from_utf8(&bytes[header_start..header_end])
         .map_err(|_| NpyError::Format("header is not text".into()))?;
     let (descr, fortran, shape) = parse_header(header)?;
+    from_raw(descr, fortran, shape, &bytes[header_end..])
+}
+
+/// Decodes an array from its dtype string (`'<f8'`, `'|u1'`, …), memory order, shape and raw
+/// element bytes, as `.npy` files and pickled NumPy arrays both store them.
+pub fn from_raw(descr: &str, fortran: bool, shape: Vec<usize>, raw: &[u8]) -> Result<NpyArray, NpyError> {
+    let descr = parse_descr(descr)?;
     let count = shape
         .iter()
         .try_fold(1usize, |a, &d| a.checked_mul(d))
         .ok_or_else(|| NpyError::Format("shape overflows".into()))?;
     let elem = if descr.kind == Kind::Unicode { 4 * descr.size } else { descr.size };
     let need = count.checked_mul(elem).ok_or_else(|| NpyError::Format("shape overflows".into()))?;
-    let raw = &bytes[header_end..];
     if raw.len() < need {
         return Err(NpyError::Format(format!(
             "truncated data: shape {shape:?} needs {need} bytes, found {}",
