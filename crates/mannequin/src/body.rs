@@ -11,10 +11,9 @@ use mannequin_mesh::TriMesh;
 pub enum BodyCommand {
     /// Print a model's family, sizes, joints and shape space.
     ///
-    /// MODEL is `default`, `default-lod1`, or a SMPL/SMPL-H/SMPL-X `.npz`. A `.pkl` model is
-    /// converted once with the one-liner in the README ("Models").
+    /// MODEL is `default`, `default-lod1`, or a SMPL/SMPL-H/SMPL-X `.npz` or released `.pkl`.
     Info {
-        /// `default`, `default-lod1` or a model `.npz`.
+        /// `default`, `default-lod1` or a model `.npz` or `.pkl`.
         model: String,
         /// Also list every joint with its parent and rest position.
         #[arg(long)]
@@ -27,7 +26,7 @@ pub enum BodyCommand {
 /// Shape, pose and model options shared by the body verbs.
 #[derive(Args)]
 pub struct BodyArgs {
-    /// `default`, `default-lod1` or a SMPL-family `.npz`.
+    /// `default`, `default-lod1` or a SMPL-family `.npz` or `.pkl`.
     #[arg(long, default_value = "default")]
     pub model: String,
     /// Shape coefficients, comma-separated (missing ones are 0).
