@@ -7,7 +7,7 @@ use mannequin_io::Npz;
 
 use crate::error::BodyError;
 use crate::model::BodyModel;
-use crate::smpl_npz::{load_npz, parse_model};
+use crate::smpl_npz::{load_model, parse_model};
 
 static FULL: &[u8] = include_bytes!("../assets/default_body.npz");
 static LOD1: &[u8] = include_bytes!("../assets/default_body_lod1.npz");
@@ -32,12 +32,12 @@ impl BodyModel {
         embedded("default_body_lod1.npz", LOD1)
     }
 
-    /// `default`, `default-lod1`, or the path of a SMPL-family `.npz` file.
+    /// `default`, `default-lod1`, or the path of a SMPL-family `.npz` or `.pkl` file.
     pub fn from_spec(spec: &str, num_betas: Option<usize>) -> Result<Self, BodyError> {
         let model = match spec {
             "default" => Self::default_body(),
             "default-lod1" => Self::default_body_lod1(),
-            path => return load_npz(Path::new(path), num_betas),
+            path => return load_model(Path::new(path), num_betas),
         };
         match num_betas {
             Some(n) => model.with_num_betas(n),

@@ -22,4 +22,4 @@ pub use model::{BodyModel, BodyModelParts, ModelFamily};
 pub use motion::Motion;
 pub use named_pose::{POSE_NAMES, named_pose};
 pub use skinned_export::{skeletal_animation, skinned_body};
-pub use smpl_npz::{load_npz, parse_model};
+pub use smpl_npz::{load_model, parse_model};

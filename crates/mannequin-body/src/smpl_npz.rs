@@ -1,17 +1,12 @@
-//! Loads SMPL, SMPL-H and SMPL-X model files in the `.npz` layout (`v_template, shapedirs,
-//! posedirs, J_regressor, weights, kintree_table, f`), float32 or float64 alike.
-//!
-//! The original `.pkl` files hold numpy and scipy-sparse arrays; convert them once with
-//! (needs numpy, scipy; chumpy too for the original SMPL release):
-//!
-//! ```text
-//! python -c "import sys,pickle,numpy as n; d=pickle.load(open(sys.argv[1],'rb'),encoding='latin1'); n.savez(sys.argv[2],**{k:(v.toarray() if hasattr(v,'toarray') else n.asarray(v)) for k,v in d.items() if k!='bs_type' and k!='bs_style'})" model.pkl model.npz
-//! ```
+//! Loads SMPL, SMPL-H and SMPL-X model files with the arrays `v_template, shapedirs, posedirs,
+//! J_regressor, weights, kintree_table, f`, float32 or float64 alike: `.npz` archives, and the
+//! released `.pkl` files (NumPy arrays, SciPy sparse matrices and chumpy objects, read by
+//! `mannequin_io::pickle_arrays` without Python).
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use mannequin_io::{NpyData, Npz};
+use mannequin_io::{IoError, NpyData, Npz};
 use mannequin_mesh::UvLayout;
 
 use crate::error::BodyError;
@@ -91,7 +86,7 @@ fn parents(npz: &Npz) -> Result<Vec<Option<usize>>, BodyError> {
     Ok(ints[..j].iter().map(|&p| if p < 0 || p >= j as i64 { None } else { Some(p as usize) }).collect())
 }
 
-/// Reads a SMPL-family model from the bytes of an `.npz` file; `path` names it in errors.
+/// Reads a SMPL-family model from the arrays of a model file; their `path` names it in errors.
 pub fn parse_model(npz: &Npz, num_betas: Option<usize>) -> Result<BodyModel, BodyError> {
     let path = npz.path.clone();
     let (_, vt) = npz.f64_with_shape("v_template", &[None, Some(3)])?;
@@ -160,13 +155,17 @@ pub fn parse_model(npz: &Npz, num_betas: Option<usize>) -> Result<BodyModel, Bod
     })
 }
 
-/// Loads a SMPL-family `.npz` model, keeping `num_betas` shape components (all when `None`).
-pub fn load_npz(path: &Path, num_betas: Option<usize>) -> Result<BodyModel, BodyError> {
-    if path.extension().is_some_and(|e| e == "pkl") {
-        return Err(BodyError::input(
-            path.display().to_string(),
-            "pickle files are read through a one-time conversion to .npz; see `mannequin body info --help`",
-        ));
-    }
-    parse_model(&Npz::read(path)?, num_betas)
+/// Loads a SMPL-family `.npz` or `.pkl` model, keeping `num_betas` shape components (all when
+/// `None`). A zip archive is read as `.npz`; a pickle is known by its protocol marker (0x80,
+/// protocols 2–5) or, for protocols 0–1 that have none, by the `.pkl` extension.
+pub fn load_model(path: &Path, num_betas: Option<usize>) -> Result<BodyModel, BodyError> {
+    let bytes = std::fs::read(path).map_err(|source| IoError::Io { path: path.to_path_buf(), source })?;
+    let pickled = !bytes.starts_with(b"PK")
+        && (bytes.first() == Some(&0x80) || path.extension().is_some_and(|e| e == "pkl"));
+    let arrays = if pickled {
+        Npz::from_pickle(path.to_path_buf(), &bytes)?
+    } else {
+        Npz::from_bytes(path.to_path_buf(), &bytes)?
+    };
+    parse_model(&arrays, num_betas)
 }

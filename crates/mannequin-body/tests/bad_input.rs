@@ -6,7 +6,7 @@ mod scratch;
 
 use std::path::PathBuf;
 
-use mannequin_body::{Motion, load_npz, parse_model};
+use mannequin_body::{Motion, load_model, parse_model};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use scratch::Scratch;
 
@@ -37,7 +37,7 @@ fn missing_key_names_file_and_key() {
     let path = dir.join("no_weights.npz");
     let arrays: Vec<_> = model_arrays().into_iter().filter(|(k, _)| k != "weights").collect();
     write(&path, &arrays);
-    let msg = load_npz(&path, None).unwrap_err().to_string();
+    let msg = load_model(&path, None).unwrap_err().to_string();
     one_line(&msg, "no_weights.npz", "weights");
 }
 
@@ -52,7 +52,7 @@ fn wrong_shape_names_field_and_expected_shape() {
         }
     }
     write(&path, &arrays);
-    let msg = load_npz(&path, None).unwrap_err().to_string();
+    let msg = load_model(&path, None).unwrap_err().to_string();
     one_line(&msg, "bad_shape.npz", "J_regressor");
     assert!(msg.contains("expected shape (24, 48)"), "{msg}");
 }
@@ -72,7 +72,7 @@ fn truncated_npz_is_a_clean_error() {
     for cut in [0, 20, full.len() / 3, full.len() - 10] {
         let path = dir.join(format!("cut_{cut}.npz"));
         std::fs::write(&path, &full[..cut]).unwrap();
-        let msg = load_npz(&path, None).unwrap_err().to_string();
+        let msg = load_model(&path, None).unwrap_err().to_string();
         one_line(&msg, &format!("cut_{cut}.npz"), "");
     }
 }

@@ -113,7 +113,7 @@ fn main() {
         1.0 / fast,
         direct / fast
     );
-    let both = time(10, || psnr(&a, &b) + ssim(&a, &b));
+    let both = time(10, || (psnr(&a, &b), ssim(&a, &b)));
     println!("PSNR + SSIM per frame       : {:8.1} frames/s", 1.0 / both);
 
     let (pos, faces) = sphere(90, 144);

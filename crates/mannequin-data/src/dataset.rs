@@ -9,6 +9,7 @@ use mannequin_mesh::ply::{self, PlyMesh};
 
 use crate::Camera;
 use crate::error::DataError;
+use crate::frame_files::{ImageFiles, list_frame_files};
 use crate::image::{Image, Mask};
 use crate::layout;
 use crate::maps::{DepthMap, NormalMap, read_mask_npy};
@@ -113,21 +114,8 @@ pub struct Dataset {
     pub has_depth: bool,
     pub has_meshes: bool,
     native: Camera,
-}
-
-/// The frame numbers of `<root>/<folder>/<prefix>_NNNN.<ext>`, sorted; other files are ignored.
-fn list_frames(root: &Path, folder: &str, prefix: &str, ext: &str) -> Result<Vec<usize>, DataError> {
-    let dir = root.join(folder);
-    let entries = std::fs::read_dir(&dir).map_err(|e| DataError::os(&dir, e))?;
-    let mut frames = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|e| DataError::os(&dir, e))?;
-        if let Some(n) = layout::frame_number(&entry.file_name().to_string_lossy(), prefix, ext) {
-            frames.push(n);
-        }
-    }
-    frames.sort_unstable();
-    Ok(frames)
+    /// The extension the images share (`png`, `jpg` or `jpeg`).
+    image_ext: &'static str,
 }
 
 /// The first number missing from `0..` in a sorted list, if the list is not exactly `0..len`.
@@ -145,21 +133,25 @@ impl Dataset {
         }
         let cameras_path = root.join(layout::CAMERAS);
         let cameras = Cameras::read(&cameras_path)?;
-        let images = list_frames(&root, layout::IMAGES, "image", "png")?;
-        if images.is_empty() {
-            return Err(DataError::file(root.join(layout::IMAGES), "no image_NNNN.png files"));
-        }
-        if let Some(gap) = first_gap(&images) {
+        let images = ImageFiles::list(&root)?;
+        if images.frames.is_empty() {
             return Err(DataError::file(
-                layout::image(&root, gap),
+                root.join(layout::IMAGES),
+                format!("no image_NNNN.{} files", layout::IMAGE_EXTENSIONS.join("|")),
+            ));
+        }
+        if let Some(gap) = first_gap(&images.frames) {
+            return Err(DataError::file(
+                images.path(&root, gap),
                 format!(
                     "missing frame: images must be numbered 0..{} without gaps",
-                    images.last().unwrap_or(&0)
+                    images.frames.last().unwrap_or(&0)
                 ),
             ));
         }
-        let frame_count = images.len();
-        let masks = list_frames(&root, layout::MASKS, "mask", "npy")?;
+        let frame_count = images.frames.len();
+        let masks: Vec<usize> =
+            list_frame_files(&root, layout::MASKS, "mask", &["npy"])?.into_iter().map(|(n, _)| n).collect();
         if let Some(gap) = first_gap(&masks).or((masks.len() < frame_count).then_some(masks.len())) {
             return Err(DataError::file(layout::mask(&root, gap), format!("missing mask for image {gap}")));
         }
@@ -199,7 +191,7 @@ impl Dataset {
         for (name, range) in &splits {
             if let Some(&last) = range.frames().last().filter(|&&f| f >= frame_count) {
                 return Err(DataError::file(
-                    layout::image(&root, last),
+                    images.path(&root, last),
                     format!(
                         "missing frame: split '{name}' needs frames up to {last}, found {frame_count} images"
                     ),
@@ -216,8 +208,14 @@ impl Dataset {
             has_depth: root.join(layout::DEPTH).is_dir(),
             has_meshes: root.join(layout::MESHES).is_dir(),
             native,
+            image_ext: images.ext,
             root,
         })
+    }
+
+    /// The image file of `frame`.
+    pub fn image_path(&self, frame: usize) -> PathBuf {
+        layout::image_file(&self.root, frame, self.image_ext)
     }
 
     pub fn camera(&self, frame: usize) -> &Camera {
@@ -271,7 +269,7 @@ impl Dataset {
     pub fn frame(&self, index: usize) -> Result<Frame, DataError> {
         if index >= self.frame_count {
             return Err(DataError::file(
-                layout::image(&self.root, index),
+                self.image_path(index),
                 format!("missing frame: there are {} images", self.frame_count),
             ));
         }
@@ -279,8 +277,8 @@ impl Dataset {
         let size_error = |path: PathBuf, what: &str, fw: usize, fh: usize| {
             DataError::file(path, format!("{what} is {fw}×{fh} but cameras.npz says {w}×{h}"))
         };
-        let image_path = layout::image(&self.root, index);
-        let image = Image::read_png(&image_path)?;
+        let image_path = self.image_path(index);
+        let image = Image::read(&image_path)?;
         if (image.width, image.height) != (w, h) {
             return Err(size_error(image_path, "image", image.width, image.height));
         }

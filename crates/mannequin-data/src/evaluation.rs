@@ -2,9 +2,9 @@
 //!
 //! The frames scored are the ground truth's test frames, named by the caller: a prediction
 //! missing for one of them is an error, and other files in the prediction folder (left by an
-//! earlier run, say) are never scored. The ground
-//! truth is composited on the stated background with its mask; the prediction is taken as
-//! rendered. Where both folders hold normal maps (`normals/`) or meshes (`meshes/`), normal and
+//! earlier run, say) are never scored. Each folder's images may be PNG or JPEG
+//! (`images/image_NNNN.png` or `.jpg`). The ground truth is composited on the stated background
+//! with its mask; the prediction is taken as rendered. Where both folders hold normal maps (`normals/`) or meshes (`meshes/`), normal and
 //! geometry metrics are added. A ground truth at an integer multiple of the prediction's size
 //! is box-downscaled to it first (PeopleSnapshot's 1080² against 540² renders).
 
@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::dataset::Dataset;
-
 use crate::error::DataError;
+use crate::frame_files::ImageFiles;
 use crate::image::Image;
 use crate::layout;
 use crate::maps::{NormalMap, read_mask_npy};
@@ -108,20 +108,19 @@ pub(crate) fn mean_of(frames: &[FrameScores], get: impl Fn(&FrameScores) -> Opti
     (!v.is_empty()).then(|| mean(v.into_iter()))
 }
 
-/// Scores one frame.
+/// Scores one frame; `images` are the prediction's and the ground truth's image files.
 fn score_frame(
-    pred: &Path,
-    gt: &Path,
+    (pred, gt): (&Path, &Path),
+    images: &(ImageFiles, ImageFiles),
     frame: usize,
     opt: &EvalOptions,
 ) -> Result<(FrameScores, usize), DataError> {
-    let (pred_path, gt_path) = (layout::image(pred, frame), layout::image(gt, frame));
-    let p = Image::read_png(&pred_path)?;
-    let g = Image::read_png(&gt_path)?;
+    let (pred_path, gt_path) = (images.0.path(pred, frame), images.1.path(gt, frame));
+    let p = Image::read(&pred_path)?;
+    let g = Image::read(&gt_path)?;
     let factor = downscale_factor((p.width, p.height), (g.width, g.height), &pred_path, &gt_path)?;
-    if p.width.min(p.height) < 11 {
-        return Err(DataError::file(pred_path, "is smaller than SSIM's 11×11 window"));
-    }
+    // A metric's complaint (sizes, too small for its window) is about the prediction's file.
+    let on_pred = |e: DataError| DataError::file(&pred_path, e.to_string());
     let mask_path = layout::mask(gt, frame);
     let mask = read_mask_npy(&mask_path)?;
     if (mask.width, mask.height) != (g.width, g.height) {
@@ -134,7 +133,8 @@ fn score_frame(
     if factor > 1 {
         g = g.downscale(factor);
     }
-    let lpips = opt.lpips.as_ref().map(|m| m.distance(&p, &g)).transpose()?;
+    let (psnr, ssim) = (psnr(&p, &g).map_err(on_pred)?, ssim(&p, &g).map_err(on_pred)?);
+    let lpips = opt.lpips.as_ref().map(|m| m.distance(&p, &g)).transpose().map_err(on_pred)?;
     let (pn_path, gn_path) = (layout::normal(pred, frame), layout::normal(gt, frame));
     let normals = if pn_path.exists() && gn_path.exists() {
         let pn = NormalMap::read_png(&pn_path)?;
@@ -142,13 +142,7 @@ fn score_frame(
         if factor > 1 {
             gn = gn.downscale(factor);
         }
-        if (pn.width, pn.height) != (gn.width, gn.height) {
-            return Err(DataError::file(
-                pn_path,
-                format!("normal map is {}×{}, ground truth {}×{}", pn.width, pn.height, gn.width, gn.height),
-            ));
-        }
-        Some(normal_error(&pn, &gn))
+        Some(normal_error(&pn, &gn).map_err(|e| DataError::file(&pn_path, e.to_string()))?)
     } else {
         None
     };
@@ -163,8 +157,8 @@ fn score_frame(
     Ok((
         FrameScores {
             frame,
-            psnr: psnr(&p, &g),
-            ssim: ssim(&p, &g),
+            psnr,
+            ssim,
             lpips,
             normal_mse_x1e3: normals.map(|n| n.mse_x1e3),
             normal_angle_deg: normals.map(|n| n.angular_deg),
@@ -188,10 +182,11 @@ pub fn evaluate(
     if frames.is_empty() {
         return Err(DataError::file(gt, "no test frames to score"));
     }
+    let images = (ImageFiles::list(pred)?, ImageFiles::list(gt)?);
     let mut per_frame = Vec::with_capacity(frames.len());
     let mut gt_downscale = 1;
     for &f in frames {
-        let (scores, factor) = score_frame(pred, gt, f, opt)?;
+        let (scores, factor) = score_frame((pred, gt), &images, f, opt)?;
         gt_downscale = factor;
         on_frame(&scores);
         per_frame.push(scores);

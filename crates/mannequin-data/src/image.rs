@@ -1,7 +1,7 @@
 //! RGB images and masks: `[0,1]` f32 in memory, 8-bit sRGB PNG on disk (values are stored as
-//! they are, `byte = round(255 v)`, with no gamma conversion, as the peers load them).
+//! they are, `byte = round(255 v)`, with no gamma conversion, as the peers load them). Reading
+//! accepts JPEG too (`image_decode.rs`).
 
-use std::io::{BufReader, Cursor};
 use std::path::Path;
 
 use crate::error::DataError;
@@ -30,45 +30,6 @@ pub fn quantize(v: f32) -> u8 {
 impl Image {
     pub fn at(&self, x: usize, y: usize) -> [f32; 3] {
         self.pixels[y * self.width + x]
-    }
-
-    /// Decodes an 8- or 16-bit PNG of any colour type; alpha is dropped, grey is replicated.
-    pub fn decode_png(path: &Path, bytes: &[u8]) -> Result<Self, DataError> {
-        let err = |e: png::DecodingError| DataError::file(path, format!("not a readable PNG: {e}"));
-        let mut decoder = png::Decoder::new(BufReader::new(Cursor::new(bytes)));
-        decoder.set_transformations(png::Transformations::EXPAND);
-        let mut reader = decoder.read_info().map_err(err)?;
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| DataError::file(path, "PNG dimensions are too large"))?;
-        let mut buf = vec![0u8; size];
-        let info = reader.next_frame(&mut buf).map_err(err)?;
-        let (w, h) = (info.width as usize, info.height as usize);
-        let channels = info.color_type.samples();
-        let sixteen = info.bit_depth == png::BitDepth::Sixteen;
-        let sample = |i: usize| -> f32 {
-            if sixteen {
-                u16::from_be_bytes([buf[2 * i], buf[2 * i + 1]]) as f32 / 65535.0
-            } else {
-                buf[i] as f32 / 255.0
-            }
-        };
-        let pixels = (0..w * h)
-            .map(|p| {
-                let base = p * channels;
-                if channels >= 3 {
-                    [sample(base), sample(base + 1), sample(base + 2)]
-                } else {
-                    [sample(base); 3]
-                }
-            })
-            .collect();
-        Ok(Self { width: w, height: h, pixels })
-    }
-
-    pub fn read_png(path: &Path) -> Result<Self, DataError> {
-        let bytes = std::fs::read(path).map_err(|e| DataError::os(path, e))?;
-        Self::decode_png(path, &bytes)
     }
 
     /// 8-bit RGB PNG bytes, tagged sRGB.
@@ -181,11 +142,5 @@ mod tests {
         assert_eq!((d.width, d.height), (2, 1));
         // Block (0,1,4,5) and block (2,3,6,7).
         assert_eq!(d.pixels, vec![[2.5, 0.0, 1.0], [4.5, 0.0, 1.0]]);
-    }
-
-    #[test]
-    fn garbage_png_names_the_file() {
-        let err = Image::decode_png(Path::new("images/image_0003.png"), b"nope").unwrap_err().to_string();
-        assert!(err.contains("images/image_0003.png"), "{err}");
     }
 }

@@ -14,8 +14,16 @@ pub const POSES: &str = "poses";
 /// All frames' SMPL parameters, sliced by each split's range when no per-split file exists.
 pub const ALL_POSES: &str = "poses.npz";
 
+/// Extensions an image frame may have, the written one (PNG) first.
+pub const IMAGE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
+
+/// The image of `frame` as Mannequin writes it (PNG).
 pub fn image(root: &Path, frame: usize) -> PathBuf {
-    root.join(IMAGES).join(format!("image_{frame:04}.png"))
+    image_file(root, frame, IMAGE_EXTENSIONS[0])
+}
+
+pub fn image_file(root: &Path, frame: usize, ext: &str) -> PathBuf {
+    root.join(IMAGES).join(format!("image_{frame:04}.{ext}"))
 }
 
 pub fn mask(root: &Path, frame: usize) -> PathBuf {

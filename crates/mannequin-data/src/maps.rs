@@ -74,6 +74,8 @@ impl NormalMap {
         Self { width: img.width, height: img.height, normals }
     }
 
+    /// PNG only: JPEG's lossy blocks would bend the encoded directions and bleed colour into the
+    /// black background, which would then read as normals.
     pub fn read_png(path: &Path) -> Result<Self, DataError> {
         Ok(Self::from_image(&Image::read_png(path)?))
     }

@@ -9,6 +9,14 @@ pub enum NpyError {
     Format(String),
 }
 
+/// A problem inside a pickle's bytes, before the file name is known.
+#[derive(Debug, thiserror::Error)]
+#[error("at byte {offset}: {reason}")]
+pub struct PickleError {
+    pub offset: usize,
+    pub reason: String,
+}
+
 /// A problem with a file on disk, naming the file and (where known) the array key.
 #[derive(Debug, thiserror::Error)]
 pub enum IoError {
@@ -16,6 +24,8 @@ pub enum IoError {
     Io { path: PathBuf, source: std::io::Error },
     #[error("{path}: not a readable .npz archive: {reason}")]
     Archive { path: PathBuf, reason: String },
+    #[error("{path}: {reason}")]
+    Pickle { path: PathBuf, reason: String },
     #[error("{path}: missing key '{key}' (present: {present})")]
     MissingKey { path: PathBuf, key: String, present: String },
     #[error("{path}: field '{key}': {reason}")]

@@ -1,15 +1,17 @@
-//! File plumbing shared by every Mannequin crate: NumPy arrays, PLY headers and values, and
-//! atomic writes.
+//! File plumbing shared by every Mannequin crate: NumPy arrays (in `.npy`, `.npz`, or pickled),
+//! PLY headers and values, and atomic writes.
 
 pub mod atomic;
 pub mod error;
 pub mod npy;
 pub mod npz;
+pub mod pickle;
+pub mod pickle_arrays;
 pub mod ply_body;
 pub mod ply_header;
 
 pub use atomic::{write_atomic, write_atomic_with};
-pub use error::{IoError, NpyError};
+pub use error::{IoError, NpyError, PickleError};
 pub use npy::{NpyArray, NpyData};
 pub use npz::{Npz, NpzWriter};
 pub use ply_body::{PlyValueError, PlyValues};

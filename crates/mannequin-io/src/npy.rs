@@ -177,7 +177,7 @@ fn header_field<'a>(header: &'a str, key: &str) -> Result<&'a str, NpyError> {
     Ok(after.trim_start())
 }
 
-fn parse_header(header: &str) -> Result<(Descr, bool, Vec<usize>), NpyError> {
+fn parse_header(header: &str) -> Result<(&str, bool, Vec<usize>), NpyError> {
     let descr_txt = header_field(header, "descr")?;
     let quote = descr_txt
         .chars()
@@ -185,7 +185,7 @@ fn parse_header(header: &str) -> Result<(Descr, bool, Vec<usize>), NpyError> {
         .filter(|c| *c == '\'' || *c == '"')
         .ok_or_else(|| NpyError::Format("structured dtypes are not supported".into()))?;
     let end = descr_txt[1..].find(quote).ok_or_else(|| NpyError::Format("unterminated 'descr'".into()))?;
-    let descr = parse_descr(&descr_txt[1..1 + end])?;
+    let descr = &descr_txt[1..1 + end];
 
     let fortran = header_field(header, "fortran_order")?.starts_with("True");
 
@@ -330,9 +330,15 @@ struct Header {
     descr: Descr,
     fortran: bool,
     shape: Vec<usize>,
-    count: usize,
     data_start: usize,
     data_len: usize,
+}
+
+/// Elements in `shape` and the bytes they take, or an error where either overflows.
+fn extent(descr: &Descr, shape: &[usize]) -> Result<(usize, usize), NpyError> {
+    let overflow = || NpyError::Format(format!("shape {shape:?} overflows"));
+    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(overflow)?;
+    Ok((count, count.checked_mul(descr.size).ok_or_else(overflow)?))
 }
 
 fn read_header(bytes: &[u8]) -> Result<Header, NpyError> {
@@ -341,11 +347,10 @@ fn read_header(bytes: &[u8]) -> Result<Header, NpyError> {
     let header = bytes.get(span).ok_or_else(|| NpyError::Format("truncated header".into()))?;
     let header = std::str::from_utf8(header).map_err(|_| NpyError::Format("header is not text".into()))?;
     let (descr, fortran, shape) = parse_header(header)?;
-    let overflow = || NpyError::Format(format!("shape {shape:?} overflows"));
-    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(overflow)?;
-    let data_len = count.checked_mul(descr.size).ok_or_else(overflow)?;
-    data_start.checked_add(data_len).ok_or_else(overflow)?;
-    Ok(Header { descr, fortran, shape, count, data_start, data_len })
+    let descr = parse_descr(descr)?;
+    let (_, data_len) = extent(&descr, &shape)?;
+    data_start.checked_add(data_len).ok_or_else(|| NpyError::Format(format!("shape {shape:?} overflows")))?;
+    Ok(Header { descr, fortran, shape, data_start, data_len })
 }
 
 /// Bytes the whole file takes, header and data, by its header's shape and dtype; `bytes` must
@@ -356,15 +361,26 @@ pub fn declared_len(bytes: &[u8]) -> Result<usize, NpyError> {
 
 /// Parses one `.npy` file held in memory.
 pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
-    let Header { descr, fortran, shape, count, data_start, data_len } = read_header(bytes)?;
-    let raw = &bytes[data_start.min(bytes.len())..];
+    let Header { descr, fortran, shape, data_start, .. } = read_header(bytes)?;
+    decode_array(&descr, fortran, shape, &bytes[data_start.min(bytes.len())..])
+}
+
+/// Decodes an array from its dtype string (`'<f8'`, `'|u1'`, …), memory order, shape and raw
+/// element bytes, as `.npy` files and pickled NumPy arrays both store them.
+pub fn from_raw(descr: &str, fortran: bool, shape: Vec<usize>, raw: &[u8]) -> Result<NpyArray, NpyError> {
+    decode_array(&parse_descr(descr)?, fortran, shape, raw)
+}
+
+/// The array of `shape` in `raw`, which must hold every element, reordered to C order.
+fn decode_array(descr: &Descr, fortran: bool, shape: Vec<usize>, raw: &[u8]) -> Result<NpyArray, NpyError> {
+    let (count, data_len) = extent(descr, &shape)?;
     if raw.len() < data_len {
         return Err(NpyError::Format(format!(
             "truncated data: shape {shape:?} needs {data_len} bytes, found {}",
             raw.len()
         )));
     }
-    let mut data = decode(&descr, raw, count)?;
+    let mut data = decode(descr, raw, count)?;
     if fortran {
         data = match data {
             NpyData::F32(v) => NpyData::F32(fortran_to_c(&v, &shape)),

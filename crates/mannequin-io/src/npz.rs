@@ -8,11 +8,15 @@ use crate::atomic::write_atomic;
 use crate::error::{IoError, NpyError};
 use crate::npy::{self, NpyArray, NpyData, parse_npy, write_npy};
 
-/// All arrays of one `.npz` file, decoded eagerly, with the file name kept for errors.
+/// All arrays of one `.npz` file (or of a pickled dict, see `pickle_arrays.rs`), decoded
+/// eagerly, with the file name kept for errors.
 #[derive(Debug, Clone)]
 pub struct Npz {
     pub path: PathBuf,
     arrays: BTreeMap<String, NpyArray>,
+    /// Keys of a pickled dict whose values are not arrays, and what each is instead, so that
+    /// asking for one says why rather than that it is missing.
+    not_arrays: BTreeMap<String, String>,
 }
 
 impl Npz {
@@ -43,7 +47,16 @@ impl Npz {
                 })?;
             arrays.insert(key, array);
         }
-        Ok(Self { path, arrays })
+        Ok(Self { path, arrays, not_arrays: BTreeMap::new() })
+    }
+
+    /// Arrays decoded from another container; `not_arrays` says what each other key holds.
+    pub(crate) fn from_parts(
+        path: PathBuf,
+        arrays: BTreeMap<String, NpyArray>,
+        not_arrays: BTreeMap<String, String>,
+    ) -> Self {
+        Self { path, arrays, not_arrays }
     }
 
     pub fn keys(&self) -> impl Iterator<Item = &str> {
@@ -58,8 +71,12 @@ impl Npz {
         self.arrays.get(key)
     }
 
-    /// The array under `key`, or an error that lists the keys that are there.
+    /// The array under `key`, or an error that says what the key holds instead or lists the
+    /// keys that are there.
     pub fn require(&self, key: &str) -> Result<&NpyArray, IoError> {
+        if let Some(what) = self.not_arrays.get(key) {
+            return Err(self.field_error(key, what.clone()));
+        }
         self.arrays.get(key).ok_or_else(|| IoError::MissingKey {
             path: self.path.clone(),
             key: key.to_string(),

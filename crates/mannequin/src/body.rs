@@ -25,7 +25,7 @@ pub enum BodyCommand {
 /// The body model and its shape, shared by the body verbs.
 #[derive(Args)]
 pub struct BodyArgs {
-    /// Body model: `default`, `default-lod1`, or a SMPL / SMPL-H / SMPL-X `.npz`.
+    /// Body model: `default`, `default-lod1`, or a SMPL / SMPL-H / SMPL-X `.npz` or released `.pkl`.
     #[arg(long, default_value = "default")]
     pub body: String,
     /// Shape coefficients, comma-separated (missing ones are 0).
@@ -35,7 +35,7 @@ pub struct BodyArgs {
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// Body model: `default`, `default-lod1`, or a SMPL / SMPL-H / SMPL-X `.npz`.
+    /// Body model: `default`, `default-lod1`, or a SMPL / SMPL-H / SMPL-X `.npz` or released `.pkl`.
     #[arg(long, default_value = "default")]
     body: String,
     /// Also list every joint with its parent and rest position.

@@ -24,7 +24,7 @@ pub struct Args {
     /// test/novel_pose of `mannequin synth`, or else the folder's own test split (`test`).
     #[arg(long, requires = "avatar")]
     data: Option<PathBuf>,
-    /// Folder of predictions (images/image_NNNN.png, optionally normals/ and meshes/) for the
+    /// Folder of predictions (images/image_NNNN.png or .jpg, optionally normals/ and meshes/) for the
     /// test frames of --gt.
     #[arg(long, requires = "gt")]
     pred: Option<PathBuf>,

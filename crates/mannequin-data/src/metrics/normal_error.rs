@@ -5,6 +5,7 @@
 //! - `angular_deg`: the mean angle in degrees between predicted and ground-truth normals over the
 //!   ground-truth foreground; a predicted background pixel there counts as 90°.
 
+use crate::error::DataError;
 use crate::maps::NormalMap;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -13,8 +14,14 @@ pub struct NormalError {
     pub angular_deg: f64,
 }
 
-pub fn normal_error(pred: &NormalMap, gt: &NormalMap) -> NormalError {
-    assert_eq!((pred.width, pred.height), (gt.width, gt.height), "normal maps of different sizes");
+/// Both error forms; normal maps of different sizes are an error.
+pub fn normal_error(pred: &NormalMap, gt: &NormalMap) -> Result<NormalError, DataError> {
+    if (pred.width, pred.height) != (gt.width, gt.height) {
+        return Err(DataError::Invalid(format!(
+            "normal error of maps of different sizes: prediction {}×{}, ground truth {}×{}",
+            pred.width, pred.height, gt.width, gt.height
+        )));
+    }
     let mut sq = 0.0;
     let (mut angle, mut count) = (0.0, 0usize);
     for (p, g) in pred.normals.iter().zip(&gt.normals) {
@@ -29,10 +36,10 @@ pub fn normal_error(pred: &NormalMap, gt: &NormalMap) -> NormalError {
             count += 1;
         }
     }
-    NormalError {
+    Ok(NormalError {
         mse_x1e3: 1e3 * sq / (3 * pred.normals.len()) as f64,
         angular_deg: if count > 0 { angle / count as f64 } else { 0.0 },
-    }
+    })
 }
 
 #[cfg(test)]
@@ -52,7 +59,7 @@ mod tests {
             height: 1,
             normals: vec![[0.0, 0.0, -1.0], [s, 0.0, -s], [0.0; 3], [0.0; 3]],
         };
-        let e = normal_error(&pred, &gt);
+        let e = normal_error(&pred, &gt).unwrap();
         // Angles 0°, 45°, 90° (missing prediction) over three foreground pixels.
         assert!((e.angular_deg - 45.0).abs() < 1e-5, "{}", e.angular_deg);
         // Squared differences: 0, (s² + (1 − s)²), 1, 0 over 12 components.

@@ -7,6 +7,7 @@
 
 use rayon::prelude::*;
 
+use crate::error::DataError;
 use crate::image::Image;
 
 const RADIUS: usize = 5;
@@ -31,9 +32,21 @@ fn ssim_at(mx: f64, my: f64, mxx: f64, myy: f64, mxy: f64) -> f64 {
     ((2.0 * mx * my + C1) * (2.0 * vxy + C2)) / ((mx * mx + my * my + C1) * (vx + vy + C2))
 }
 
-fn check(a: &Image, b: &Image) {
-    assert_eq!((a.width, a.height), (b.width, b.height), "images of different sizes");
-    assert!(a.width >= TAPS && a.height >= TAPS, "SSIM needs images of at least 11×11 pixels");
+/// Both images must have one size, with room for the whole window.
+fn check(a: &Image, b: &Image) -> Result<(), DataError> {
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(DataError::Invalid(format!(
+            "SSIM of images of different sizes: {}×{} and {}×{}",
+            a.width, a.height, b.width, b.height
+        )));
+    }
+    if a.width < TAPS || a.height < TAPS {
+        return Err(DataError::Invalid(format!(
+            "SSIM needs images of at least {TAPS}×{TAPS} pixels (its window), got {}×{}",
+            a.width, a.height
+        )));
+    }
+    Ok(())
 }
 
 /// `out[x] = Σ_k g[k] · row[x + k]` for every x where the window fits: a row of the separable
@@ -49,8 +62,8 @@ fn filter_row(g: &[f64; TAPS], row: &[f64], out: &mut [f64]) {
 
 /// Mean SSIM of two RGB images in [0, 1]: per channel, the five moment planes are filtered
 /// separably (rows, then columns), rows in parallel.
-pub fn ssim(a: &Image, b: &Image) -> f64 {
-    check(a, b);
+pub fn ssim(a: &Image, b: &Image) -> Result<f64, DataError> {
+    check(a, b)?;
     let (w, h) = (a.width, a.height);
     let (ow, oh) = (w - 2 * RADIUS, h - 2 * RADIUS);
     let g = window();
@@ -91,13 +104,13 @@ pub fn ssim(a: &Image, b: &Image) -> f64 {
             .sum();
         total += sum / (ow * oh) as f64;
     }
-    total / 3.0
+    Ok(total / 3.0)
 }
 
 /// The same quantity by the definition: a direct 11×11 window per pixel, single-threaded. It is
 /// the reference the fast version is tested and benchmarked against.
-pub fn ssim_direct(a: &Image, b: &Image) -> f64 {
-    check(a, b);
+pub fn ssim_direct(a: &Image, b: &Image) -> Result<f64, DataError> {
+    check(a, b)?;
     let (w, h) = (a.width, a.height);
     let g = window();
     let mut total = 0.0;
@@ -123,7 +136,7 @@ pub fn ssim_direct(a: &Image, b: &Image) -> f64 {
         }
         total += sum / ((w - 2 * RADIUS) * (h - 2 * RADIUS)) as f64;
     }
-    total / 3.0
+    Ok(total / 3.0)
 }
 
 #[cfg(test)]
@@ -143,8 +156,8 @@ mod tests {
             height: 17,
             pixels: a.pixels.iter().map(|p| p.map(|v| (v * 0.8 + 0.1).min(1.0))).collect(),
         };
-        assert!((ssim(&a, &a) - 1.0).abs() < 1e-12);
-        let (fast, direct) = (ssim(&a, &b), ssim_direct(&a, &b));
+        assert!((ssim(&a, &a).unwrap() - 1.0).abs() < 1e-12);
+        let (fast, direct) = (ssim(&a, &b).unwrap(), ssim_direct(&a, &b).unwrap());
         assert!((fast - direct).abs() < 1e-12, "{fast} vs {direct}");
         assert!(fast < 0.99);
     }
