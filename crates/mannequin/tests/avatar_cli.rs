@@ -2,7 +2,7 @@
 //! iterations: `export` (meshes, skinned glTF, 3DGS splats) and `animate --avatar`.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::sync::OnceLock;
 
 use burn::tensor::Device;
@@ -10,36 +10,18 @@ use mannequin_avatar::Avatar;
 use mannequin_body::named_pose;
 use mannequin_splat::SplatScene;
 
+mod common;
+use common::{mannequin, ok, one_line_error, s, scratch, usage_error};
+
 #[path = "../../../tools/node_checks.rs"]
 mod node_checks;
 use node_checks::KHRONOS_VALIDATOR;
-
-fn mannequin(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap()
-}
-
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    o
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Scratch folder `name`, emptied.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("avatar-cli-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// One model folder for every test: synthesised and trained once (a few seconds).
 fn model() -> &'static Path {
     static MODEL: OnceLock<PathBuf> = OnceLock::new();
     MODEL.get_or_init(|| {
-        let dir = scratch("model");
+        let dir = scratch("avatar-cli-model");
         let (data, model) = (dir.join("data"), dir.join("model"));
         ok(mannequin(&[
             "synth",
@@ -98,7 +80,7 @@ fn png_size(path: &Path) -> (u32, u32) {
 
 #[test]
 fn export_writes_meshes_glb_and_splats() {
-    let out = scratch("export");
+    let out = scratch("avatar-cli-export");
     let avatar = Avatar::load(model(), &Device::flex()).unwrap();
     let v = avatar.canonical.num_vertices();
 
@@ -209,7 +191,7 @@ fn fake_ffmpeg(dir: &Path) {
 
 #[test]
 fn animate_renders_frames_and_video() {
-    let out = scratch("animate");
+    let out = scratch("avatar-cli-animate");
     let frames = out.join("frames");
     let no_tools = out.join("empty-path");
     std::fs::create_dir_all(&no_tools).unwrap();
@@ -264,29 +246,9 @@ fn animate_renders_frames_and_video() {
     std::fs::remove_dir_all(out).unwrap();
 }
 
-/// A usage error from clap: exit code 2, before any work, naming each of `needles`.
-fn usage_error(o: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "'{n}' not in: {err}");
-    }
-}
-
-fn one_line_error(o: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    let line =
-        err.lines().find(|l| l.starts_with("error:")).unwrap_or_else(|| panic!("no error line in {err}"));
-    for n in needles {
-        assert!(line.contains(n), "'{n}' not in: {line}");
-    }
-}
-
 #[test]
 fn bad_inputs_give_one_line_errors() {
-    let out = scratch("bad");
+    let out = scratch("avatar-cli-bad");
     let missing = out.join("no_such_model");
     let obj = out.join("x.obj");
     one_line_error(&mannequin(&["export", "--avatar", s(&missing), "-o", s(&obj)]), &["no_such_model"]);
@@ -342,7 +304,7 @@ fn scores(path: &Path) -> serde_json::Value {
 
 #[test]
 fn eval_scores_each_test_set_afresh_in_one_layout() {
-    let out = scratch("eval");
+    let out = scratch("avatar-cli-eval");
     let data = model().parent().unwrap().join("data");
     // A stale prediction left in the avatar's eval folder by an earlier run is removed.
     let stale = model().join("eval/novel_view/images/image_0099.png");

@@ -1,22 +1,12 @@
 //! The command line as a user runs it: the demo on the embedded body, and one-line errors on bad
 //! files (exit code 1, no panic).
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn mannequin(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap()
-}
-
-fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mq-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::{mannequin, one_line_error, scratch};
 
 #[test]
 fn demo_trains_evaluates_animates_and_exports() {
-    let out = temp("demo");
+    let out = scratch("cli-demo");
     // A short, small run of the README's main job: every stage, every output.
     let o = mannequin(&[
         "demo",
@@ -69,7 +59,7 @@ fn demo_trains_evaluates_animates_and_exports() {
 
 #[test]
 fn body_pose_writes_obj_and_ply() {
-    let dir = temp("pose");
+    let dir = scratch("cli-pose");
     for ext in ["obj", "ply"] {
         let path = dir.join(format!("squat.{ext}"));
         let o = mannequin(&[
@@ -90,20 +80,9 @@ fn body_pose_writes_obj_and_ply() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-fn one_line_error(o: &Output, needles: &[&str]) {
-    assert_eq!(o.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&o.stderr);
-    let line =
-        err.lines().find(|l| l.starts_with("error:")).unwrap_or_else(|| panic!("no error line in {err}"));
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(line.contains(n), "'{n}' not in: {line}");
-    }
-}
-
 #[test]
 fn bad_files_give_one_line_errors() {
-    let dir = temp("bad");
+    let dir = scratch("cli-bad");
     let model = dir.join("broken_model.npz");
     std::fs::write(&model, b"PK\x03\x04 not really a zip").unwrap();
     let out = dir.join("x.obj");
@@ -139,7 +118,7 @@ fn info_verbs_print_results_on_stdout_as_a_table_or_json() {
     let text = String::from_utf8_lossy(&table.stdout);
     assert!(text.contains(&format!("vertices     {}", lod1.num_vertices())), "{text}");
 
-    let dir = temp("splat-info");
+    let dir = scratch("cli-splat-info");
     let ply = dir.join("two.ply");
     let scene = mannequin_splat::SplatScene {
         means: vec![0.0, 1.0, 2.0, -1.0, 3.0, 0.5],
@@ -168,11 +147,11 @@ fn info_verbs_print_results_on_stdout_as_a_table_or_json() {
 }
 
 /// `animate --fps` on a motion of no frames used to panic while resampling; it is a one-line
-/// error naming the file at read. (No `--model`: the default body is enough.)
+/// error naming the file at read.
 #[test]
 fn animate_refuses_a_motion_of_no_frames() {
     use mannequin_io::{NpyArray, NpzWriter};
-    let dir = temp("empty-motion");
+    let dir = scratch("cli-empty-motion");
     let motion = dir.join("empty.npz");
     let mut w = NpzWriter::new();
     w.add("poses", NpyArray::f64(vec![0, 72], vec![]))
@@ -181,6 +160,7 @@ fn animate_refuses_a_motion_of_no_frames() {
     w.write(&motion).unwrap();
     let out = dir.join("x.glb");
     let o = mannequin(&[
+        "body",
         "animate",
         "--motion",
         motion.to_str().unwrap(),

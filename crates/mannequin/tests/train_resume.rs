@@ -8,6 +8,9 @@ use std::sync::OnceLock;
 
 use mannequin_io::{NpyData, Npz};
 
+mod common;
+use common::{ok, s, scratch};
+
 /// One thread: the claim is about checkpoints, and rayon's adaptive splitting may reorder float
 /// reductions between runs on a loaded machine.
 fn command(args: &[&str]) -> Command {
@@ -16,28 +19,11 @@ fn command(args: &[&str]) -> Command {
     c
 }
 
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    o
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Scratch folder `name`, emptied.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("train-resume-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 /// One synthetic subject for every test.
 fn data() -> &'static Path {
     static DATA: OnceLock<PathBuf> = OnceLock::new();
     DATA.get_or_init(|| {
-        let data = scratch("data").join("subject");
+        let data = scratch("train-resume-data").join("subject");
         let args = ["synth", "--seed", "3", "--size", "64", "--supersample", "1", "--frames", "10"];
         let more = ["--train", "8", "--body", "default-lod1", "--out", s(&data)];
         ok(command(&[&args[..], &more[..]].concat()).output().unwrap());
@@ -103,7 +89,7 @@ fn parameters(out: &Path) -> Vec<(String, Vec<u32>)> {
 
 #[test]
 fn a_killed_run_resumes_to_the_uninterrupted_result_bit_for_bit() {
-    let dir = scratch("killed");
+    let dir = scratch("train-resume-killed");
     let (straight, killed) = (dir.join("straight"), dir.join("killed"));
     let flags = ["--iters", "20", "--checkpoint-every", "2"];
     ok(train(&straight, &flags).output().unwrap());
@@ -136,7 +122,7 @@ fn error_line(o: &Output) -> String {
 
 #[test]
 fn other_settings_are_refused_and_restart_drops_the_checkpoint_first() {
-    let dir = scratch("settings");
+    let dir = scratch("train-resume-settings");
     let out = dir.join("model");
     let flags = ["--iters", "2", "--checkpoint-every", "1"];
     ok(train(&out, &flags).output().unwrap());

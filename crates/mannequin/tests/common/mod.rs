@@ -1,0 +1,50 @@
+//! What every CLI test needs: the binary, its outcome, and scratch folders.
+#![allow(dead_code)] // each test binary uses its own part
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs `mannequin args…` to completion.
+pub fn mannequin(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap()
+}
+
+/// The output of a run that must succeed (its stderr in the failure message otherwise).
+pub fn ok(o: Output) -> Output {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Scratch folder `name` under the test target's temporary folder, emptied.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A failure the way a user sees one: exit code 1, no panic, and one `error:` line naming
+/// each of `needles`.
+pub fn one_line_error(o: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let line =
+        err.lines().find(|l| l.starts_with("error:")).unwrap_or_else(|| panic!("no error line in {err}"));
+    for n in needles {
+        assert!(line.contains(n), "'{n}' not in: {line}");
+    }
+}
+
+/// A usage error from clap: exit code 2, before any work, naming each of `needles`.
+pub fn usage_error(o: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "'{n}' not in: {err}");
+    }
+}
