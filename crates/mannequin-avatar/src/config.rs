@@ -26,14 +26,6 @@ pub enum Method {
     Ihuman,
 }
 
-impl std::str::FromStr for Method {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        <Self as clap::ValueEnum>::from_str(s, false)
-            .map_err(|_| format!("unknown method '{s}' (expected tavatar or ihuman)"))
-    }
-}
-
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AvatarConfig {
     pub method: Method,

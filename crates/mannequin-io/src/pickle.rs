@@ -296,10 +296,7 @@ impl<'a> Machine<'a> {
                 }
                 b'S' => {
                     let t = self.line()?.to_string();
-                    let v = unquote(&t).ok_or_else(|| PickleError {
-                        offset: self.pos,
-                        reason: format!("bad quoted string {t:.40}"),
-                    })?;
+                    let Some(v) = unquote(&t) else { return self.fail(format!("bad quoted string {t:.40}")) };
                     self.push(Value::Bytes(v));
                 }
                 b'T' | b'U' | b'B' | b'C' | 0x8e | 0x96 => {
@@ -313,10 +310,9 @@ impl<'a> Machine<'a> {
                 }
                 b'V' => {
                     let t = self.line()?.to_string();
-                    let v = raw_unicode_unescape(&t).ok_or_else(|| PickleError {
-                        offset: self.pos,
-                        reason: format!("bad unicode text {t:.40}"),
-                    })?;
+                    let Some(v) = raw_unicode_unescape(&t) else {
+                        return self.fail(format!("bad unicode text {t:.40}"));
+                    };
                     self.push(Value::Str(v));
                 }
                 b'X' | 0x8c | 0x8d => {
