@@ -1,6 +1,6 @@
 // Loads a .glb with three.js's GLTFLoader in Node (no browser) and reports what a web viewer would
 // play: skinned meshes, bone counts, animation clips, and the posed mesh's bounding box at the
-// first and last key. Exits 1 if there is no skinned mesh or no animation, 2 if three.js is missing.
+// first and last key; then each morph-animated mesh (a cloth cache) and its box at the last key. Exits 1 if there is no skinned mesh or no animation, 2 if three.js is missing.
 //
 // Install three.js once:  npm install --prefix "$HOME/.cache/three-check" three
 // Usage:                  node tools/gltf_three_check.mjs FILE.glb
@@ -41,7 +41,7 @@ for (const clip of gltf.animations) {
   console.log(`  clip '${clip.name}': duration ${clip.duration.toFixed(4)} s, ${clip.tracks.length} tracks`);
 }
 
-/// The world-space bounding box of the skinned vertices at time t of the first clip.
+/// The world-space bounding box of the posed (skinned or morphed) vertices at time t of the first clip.
 function posedBox(mesh, t) {
   const mixer = new THREE.AnimationMixer(gltf.scene);
   // Play once and hold the last pose: a looping clip at t = duration wraps back to its first key.
@@ -51,7 +51,7 @@ function posedBox(mesh, t) {
   action.play();
   mixer.setTime(t);
   gltf.scene.updateMatrixWorld(true);
-  mesh.skeleton.update();
+  if (mesh.isSkinnedMesh) mesh.skeleton.update();
   const box = new THREE.Box3();
   const v = new THREE.Vector3();
   for (let i = 0; i < mesh.geometry.attributes.position.count; i++) {
@@ -66,6 +66,17 @@ if (skinned.length && gltf.animations.length) {
   const d = gltf.animations[0].duration;
   for (const t of [0, d / 3, d]) {
     console.log(`  posed box at t=${t.toFixed(4)}: ${posedBox(skinned[0], t)}`);
+  }
+}
+// Vertex caches (cloth) beside the body: unskinned meshes played by morph targets.
+const morphs = [];
+gltf.scene.traverse((o) => o.isMesh && !o.isSkinnedMesh && o.morphTargetInfluences && morphs.push(o));
+for (const m of morphs) {
+  const targets = m.geometry.morphAttributes.position.length;
+  console.log(`  morph mesh '${m.name}': ${m.geometry.attributes.position.count} vertices, ${targets} targets`);
+  if (gltf.animations.length) {
+    const t = gltf.animations[0].duration;
+    console.log(`  ${m.name} box at t=${t.toFixed(4)}: ${posedBox(m, t)}`);
   }
 }
 process.exit(skinned.length && gltf.animations.length ? 0 : 1);

@@ -10,12 +10,13 @@ pub mod mass;
 pub mod normals;
 pub mod obj;
 pub mod ply;
+pub mod ring_tube;
 pub mod subdivide;
 pub mod tri_mesh;
 
 pub use area::double_areas;
 pub use file_error::MeshFileError;
-pub use gltf::{SkeletalAnimation, Skeleton, SkinnedMesh, write_glb};
+pub use gltf::{MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, write_glb, write_scene_glb};
 pub use gradient::gradient_operator;
 pub use laplacian::cotan_laplacian;
 pub use mass::{MassKind, mass_matrix, vertex_areas};

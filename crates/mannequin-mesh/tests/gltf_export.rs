@@ -8,7 +8,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
-use mannequin_mesh::{SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh, UvLayout, write_glb};
+use mannequin_mesh::{
+    MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh, UvLayout, write_glb, write_scene_glb,
+};
 use serde_json::Value;
 
 #[path = "../../../tools/node_checks.rs"]
@@ -206,6 +208,7 @@ impl Glb {
                     translation[node] =
                         Vec3::from_slice(&values[k]).lerp(Vec3::from_slice(&values[k + 1]), s);
                 }
+                "weights" => {} // morph meshes: see morph_at
                 p => panic!("path {p}"),
             }
         }
@@ -248,6 +251,45 @@ impl Glb {
             })
             .collect();
         (bind, posed)
+    }
+}
+
+impl Glb {
+    /// The vertices of the unskinned mesh node named `name` at time `t`: its POSITION plus each
+    /// morph target's POSITION times its weight, the weights sampled LINEAR from the channel on
+    /// that node (`k` keys of `targets` values each).
+    fn morph_at(&self, name: &str, t: f32) -> Vec<Vec3> {
+        let nodes = self.doc["nodes"].as_array().unwrap();
+        let node = nodes.iter().position(|n| n["name"] == name && n.get("skin").is_none()).unwrap();
+        let primitive = &self.doc["meshes"][nodes[node]["mesh"].as_u64().unwrap() as usize]["primitives"][0];
+        let targets = primitive["targets"].as_array().unwrap();
+        let animation = &self.doc["animations"][0];
+        let channel = animation["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["node"] == node && c["target"]["path"] == "weights")
+            .unwrap();
+        let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
+        let times: Vec<f32> = self.accessor(&sampler["input"]).into_iter().map(|r| r[0]).collect();
+        let values: Vec<f32> = self.accessor(&sampler["output"]).into_iter().map(|r| r[0]).collect();
+        let k = times.iter().rposition(|&x| x <= t).unwrap().min(times.len().saturating_sub(2));
+        let s =
+            if times.len() < 2 { 0.0 } else { ((t - times[k]) / (times[k + 1] - times[k])).clamp(0.0, 1.0) };
+        let n = targets.len();
+        let weight = |i: usize| {
+            let next = if times.len() < 2 { 0.0 } else { values[(k + 1) * n + i] };
+            values[k * n + i] * (1.0 - s) + next * s
+        };
+        let mut out: Vec<Vec3> =
+            self.accessor(&primitive["attributes"]["POSITION"]).iter().map(|p| Vec3::from_slice(p)).collect();
+        for (i, target) in targets.iter().enumerate() {
+            let w = weight(i);
+            for (o, d) in out.iter_mut().zip(self.accessor(&target["POSITION"])) {
+                *o += w * Vec3::from_slice(&d);
+            }
+        }
+        out
     }
 }
 
@@ -492,4 +534,86 @@ fn three_js_plays_the_arm_as_posed_by_hand() {
             "frame {frame}: {got:?} vs {want:?}"
         );
     }
+}
+
+/// A 3×3 sheet with a UV seam down its middle column, over 4 frames at 10 fps: frame k is the
+/// sheet moved by (0, −0.1k, 0) and stretched by 1 + 0.2k along x.
+fn sheet_cache() -> MorphSequence {
+    let positions: Vec<[f32; 3]> =
+        (0..9).map(|i| [(i % 3) as f32 * 0.5, 1.0, (i / 3) as f32 * 0.5]).collect();
+    let faces = vec![[0, 3, 1], [1, 3, 4], [1, 4, 2], [2, 4, 5], [3, 6, 4], [4, 6, 7], [4, 7, 5], [5, 7, 8]];
+    let mut mesh = TriMesh::new(positions.clone(), faces.clone());
+    // Per-corner UVs: the left half's corners of column 1 take u = 0.5, the right half's u = 0.51.
+    let mut coords = Vec::new();
+    let uv_faces = faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| {
+            face.map(|v| {
+                let u = (v % 3) as f32 * 0.5 + if v % 3 == 1 && f % 4 >= 2 { 0.01 } else { 0.0 };
+                coords.push([u, (v / 3) as f32 * 0.5]);
+                coords.len() as u32 - 1
+            })
+        })
+        .collect();
+    mesh.uv = Some(UvLayout { coords, faces: uv_faces });
+    let frames = (0..4)
+        .map(|k| {
+            positions.iter().map(|p| [p[0] * (1.0 + 0.2 * k as f32), p[1] - 0.1 * k as f32, p[2]]).collect()
+        })
+        .collect();
+    MorphSequence { name: "sheet".into(), mesh, frames, fps: 10.0 }
+}
+
+/// Read back from the file, the cache plays its frames at their keys and blends neighbours
+/// linearly between them; the body's skinning is unchanged by the cache beside it.
+#[test]
+fn vertex_cache_plays_back_from_the_file() {
+    let (arm, motion, sheet) = (arm(), motion(), sheet_cache());
+    let path = temp_file("cache.glb");
+    write_scene_glb(&path, &arm, Some(&motion), std::slice::from_ref(&sheet)).unwrap();
+    let glb = Glb::read(&path);
+    std::fs::remove_file(&path).unwrap();
+    let frame = |k: f32| -> Vec<Vec3> {
+        sheet.mesh.positions.iter().map(|p| Vec3::new(p[0] * (1.0 + 0.2 * k), p[1] - 0.1 * k, p[2])).collect()
+    };
+    for (t, k) in [(0.0, 0.0), (0.1, 1.0), (0.25, 2.5), (0.3, 3.0)] {
+        let got = glb.morph_at("sheet", t);
+        assert_eq!(got.len(), 12, "9 vertices, the seam column's 3 written twice");
+        let want = frame(k);
+        for g in got {
+            // Each written vertex is one of the frame's vertices (seam copies included).
+            let nearest = want.iter().map(|w| (g - *w).length()).fold(f32::INFINITY, f32::min);
+            assert!(nearest < 1e-5, "t = {t}: {g} is no vertex of frame {k}");
+        }
+    }
+    let (bind, posed) = glb.skin_at(0.1);
+    let want = direct_lbs(&arm, &motion, 1);
+    for (b, got) in bind.iter().zip(&posed) {
+        let source = arm.mesh.positions.iter().position(|q| q == b).unwrap();
+        assert_close(*got, want[source], "arm at frame 1 beside the cache");
+    }
+    let mut bad = sheet.clone();
+    bad.frames[2].pop();
+    let e = write_scene_glb(&path, &arm, None, &[bad]).unwrap_err().to_string();
+    assert!(e.contains("sheet.frames[2]") && e.contains("9 vertices"), "{e}");
+}
+
+/// The validator and three.js on the arm with the cache beside it: three.js finds the morph mesh
+/// and its bounding box at the last key is frame 3's.
+#[test]
+fn vertex_cache_passes_the_validator_and_three_js() {
+    let (arm, motion, sheet) = (arm(), motion(), sheet_cache());
+    let path = temp_file("cache-check.glb");
+    write_scene_glb(&path, &arm, Some(&motion), std::slice::from_ref(&sheet)).unwrap();
+    let (report, three) = (KHRONOS_VALIDATOR.run(&path), THREE_JS.run(&path));
+    std::fs::remove_file(&path).unwrap();
+    if let Some(report) = report {
+        assert!(report.contains(" 0 errors, 0 warnings"), "{report}");
+    }
+    let Some(three) = three else { return };
+    assert!(three.contains("morph mesh 'sheet': 12 vertices, 4 targets"), "{three}");
+    let line = three.lines().find_map(|l| l.trim().strip_prefix("sheet box at t=0.3000: ")).expect(&three);
+    // Frame 3: x in [0, 1.6], y = 0.7, z in [0, 1].
+    assert_eq!(line, "min (0.0000, 0.7000, 0.0000) max (1.6000, 0.7000, 1.0000)", "{three}");
 }

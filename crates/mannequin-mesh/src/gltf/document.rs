@@ -5,6 +5,9 @@
 //! With identity bind rotations a joint's world matrix at frame t is `G_j(t)`, and glTF skins a
 //! vertex as `Σ_j w_j G_j(t) translate(−J_j) v`, which is SMPL's linear blend skinning
 //! (the thesis' LBS equation) without pose correctives.
+//!
+//! Vertex caches (cloth) follow as unskinned meshes at the scene root, played by morph targets
+//! in the same animation, so they stay in sync with the body.
 
 use std::path::Path;
 
@@ -15,6 +18,7 @@ use super::buffer::{ARRAY_BUFFER, Buffer, ELEMENT_ARRAY_BUFFER, Int};
 use super::glb::glb;
 use super::influences::top_four;
 use super::model::{SkeletalAnimation, SkinnedMesh};
+use super::morph::MorphSequence;
 use super::split::split_uv_seams;
 use crate::MeshFileError;
 use crate::normals::vertex_normals;
@@ -27,12 +31,26 @@ pub fn write_glb(
     skinned: &SkinnedMesh,
     animation: Option<&SkeletalAnimation>,
 ) -> Result<(), MeshFileError> {
+    write_scene_glb(path, skinned, animation, &[])
+}
+
+/// [`write_glb`] with vertex caches (`morphs`, e.g. simulated garments) beside the body, all
+/// played by the file's one animation.
+pub fn write_scene_glb(
+    path: impl AsRef<Path>,
+    skinned: &SkinnedMesh,
+    animation: Option<&SkeletalAnimation>,
+    morphs: &[MorphSequence],
+) -> Result<(), MeshFileError> {
     let path = path.as_ref();
     skinned.validate(path)?;
     if let Some(a) = animation {
         a.validate(path, skinned.skeleton.joint_count())?;
     }
-    let bytes = encode(path, skinned, animation)?;
+    for m in morphs {
+        m.validate(path)?;
+    }
+    let bytes = encode(path, skinned, animation, morphs)?;
     mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
 }
 
@@ -40,6 +58,7 @@ fn encode(
     path: &Path,
     skinned: &SkinnedMesh,
     animation: Option<&SkeletalAnimation>,
+    morphs: &[MorphSequence],
 ) -> Result<Vec<u8>, MeshFileError> {
     let skeleton = &skinned.skeleton;
     let joints = skeleton.joint_count();
@@ -75,17 +94,32 @@ fn encode(
         })
         .collect();
     nodes.push(json!({ "name": "mesh", "mesh": 0, "skin": 0 }));
+    let mut meshes = vec![json!({ "name": "mesh", "primitives": [primitive] })];
+    let mut roots = vec![0, joints];
+    for (i, m) in morphs.iter().enumerate() {
+        roots.push(nodes.len());
+        nodes.push(json!({ "name": m.name, "mesh": i + 1 }));
+        meshes.push(m.mesh_json(&mut buffer));
+    }
 
     let mut doc = json!({
         "asset": { "version": "2.0", "generator": "Mannequin" },
         "scene": 0,
-        "scenes": [{ "nodes": [0, joints] }],
+        "scenes": [{ "nodes": roots }],
         "nodes": nodes,
-        "meshes": [{ "name": "mesh", "primitives": [primitive] }],
+        "meshes": meshes,
         "skins": [{ "inverseBindMatrices": ibm, "joints": (0..joints).collect::<Vec<_>>(), "skeleton": 0 }],
     });
+    let mut track = Track::default();
     if let Some(a) = animation {
-        doc["animations"] = json!([animation_json(a, skeleton.bind_joints[0], &mut buffer)]);
+        skeletal_tracks(a, skeleton.bind_joints[0], &mut buffer, &mut track);
+    }
+    for (i, m) in morphs.iter().enumerate() {
+        track.add(m.weights_sampler(&mut buffer), joints + 1 + i, "weights");
+    }
+    if !track.channels.is_empty() {
+        doc["animations"] =
+            json!([{ "name": "motion", "samplers": track.samplers, "channels": track.channels }]);
     }
     doc["buffers"] = json!([{ "byteLength": buffer.bytes.len() }]);
     doc["bufferViews"] = json!(buffer.views);
@@ -151,28 +185,42 @@ fn primitive(path: &Path, skinned: &SkinnedMesh, buffer: &mut Buffer) -> Result<
     Ok(json!({ "attributes": attributes, "indices": indices, "mode": 4 }))
 }
 
+/// The samplers and channels of the file's one animation.
+#[derive(Default)]
+struct Track {
+    samplers: Vec<Value>,
+    channels: Vec<Value>,
+}
+
+impl Track {
+    fn add(&mut self, sampler: Value, node: usize, property: &str) {
+        self.channels
+            .push(json!({ "sampler": self.samplers.len(), "target": { "node": node, "path": property } }));
+        self.samplers.push(sampler);
+    }
+}
+
 /// One rotation channel per joint and a translation channel for the root, all sharing one
 /// time accessor.
-fn animation_json(animation: &SkeletalAnimation, root_bind: [f32; 3], buffer: &mut Buffer) -> Value {
+fn skeletal_tracks(
+    animation: &SkeletalAnimation,
+    root_bind: [f32; 3],
+    buffer: &mut Buffer,
+    track: &mut Track,
+) {
     let frames = animation.frame_count();
     let fps = animation.fps as f64;
     let times: Vec<[f32; 1]> = (0..frames).map(|i| [(i as f64 / fps) as f32]).collect();
     let input = buffer.floats(&times, true, None);
-    let mut samplers = Vec::new();
-    let mut channels = Vec::new();
-    let mut add = |output: usize, node: usize, property: &str| {
-        channels.push(json!({ "sampler": samplers.len(), "target": { "node": node, "path": property } }));
-        samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
-    };
+    let linear = |output: usize| json!({ "input": input, "output": output, "interpolation": "LINEAR" });
     let joints = animation.local_rotations[0].len();
     for j in 0..joints {
-        let track = continuous_rotations(animation.local_rotations.iter().map(|pose| pose[j]));
-        add(buffer.floats(&track, false, None), j, "rotation");
+        let rotations = continuous_rotations(animation.local_rotations.iter().map(|pose| pose[j]));
+        track.add(linear(buffer.floats(&rotations, false, None)), j, "rotation");
     }
     let root: Vec<[f32; 3]> =
         animation.root_translation.iter().map(|t| std::array::from_fn(|d| root_bind[d] + t[d])).collect();
-    add(buffer.floats(&root, false, None), 0, "translation");
-    json!({ "name": "motion", "samplers": samplers, "channels": channels })
+    track.add(linear(buffer.floats(&root, false, None)), 0, "translation");
 }
 
 /// Normalises each quaternion and flips its sign where needed so consecutive keys lie in the same

@@ -5,7 +5,7 @@
 /// The (up to) four largest positive weights of one vertex's row with their joint indices, the
 /// weights renormalised to sum to one. Unused slots are joint 0 with weight 0, as the validator
 /// expects. `None` when the row has no positive weight.
-pub(crate) fn top_four(row: &[f32]) -> Option<([u16; 4], [f32; 4])> {
+pub fn top_four(row: &[f32]) -> Option<([u16; 4], [f32; 4])> {
     let mut best: Vec<(usize, f32)> = row.iter().copied().enumerate().filter(|&(_, w)| w > 0.0).collect();
     // Largest first; ties keep the lower joint index first so the choice is deterministic.
     best.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));

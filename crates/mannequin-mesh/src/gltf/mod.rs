@@ -1,12 +1,15 @@
-//! glTF 2.0 binary (`.glb`) export of a skinned mesh and its animation, written with our own code
-//! so that the exact layout (bind pose, inverse bind matrices, sampler times) is under test.
+//! glTF 2.0 binary (`.glb`) export of a skinned mesh and its animation, with vertex caches beside
+//! it, written with our own code so that the exact layout (bind pose, inverse bind matrices,
+//! sampler times, morph keys) is under test.
 
 mod buffer;
 mod document;
 mod glb;
-mod influences;
+pub mod influences;
 mod model;
+mod morph;
 mod split;
 
-pub use document::write_glb;
+pub use document::{write_glb, write_scene_glb};
 pub use model::{SkeletalAnimation, Skeleton, SkinnedMesh};
+pub use morph::MorphSequence;

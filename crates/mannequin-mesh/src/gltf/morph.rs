@@ -1,0 +1,106 @@
+//! A mesh whose vertices move frame by frame (a cloth cache) as glTF morph targets: target k holds
+//! frame k's displacement from the base, and the weights are keyed one-hot, target k fully on at
+//! t = k / fps. LINEAR interpolation between two one-hot keys blends two frames' positions
+//! linearly, which is what a vertex cache plays between frames. Blender imports the targets as
+//! shape keys and three.js plays them.
+
+use std::path::Path;
+
+use serde_json::{Value, json};
+
+use super::buffer::{ARRAY_BUFFER, Buffer, ELEMENT_ARRAY_BUFFER, Int};
+use super::split::split_uv_seams;
+use crate::normals::vertex_normals;
+use crate::{MeshFileError, TriMesh};
+
+/// `frames` of `mesh`'s vertices at `fps`; the mesh's own positions are the base the targets
+/// displace (shown when no animation plays).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MorphSequence {
+    pub name: String,
+    pub mesh: TriMesh,
+    pub frames: Vec<Vec<[f32; 3]>>,
+    pub fps: f32,
+}
+
+impl MorphSequence {
+    pub(crate) fn validate(&self, path: &Path) -> Result<(), MeshFileError> {
+        let at = |field: &str| format!("{}.{field}", self.name);
+        self.mesh.validate().map_err(|e| MeshFileError::invalid(path, e))?;
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            let expected = format!("a positive frame rate, found {}", self.fps);
+            return Err(MeshFileError::format(path, at("fps"), expected));
+        }
+        if self.frames.is_empty() {
+            return Err(MeshFileError::format(path, at("frames"), "at least one frame"));
+        }
+        let v = self.mesh.vertex_count();
+        for (f, frame) in self.frames.iter().enumerate() {
+            if frame.len() != v {
+                let expected = format!("{v} vertices (the mesh's), found {}", frame.len());
+                return Err(MeshFileError::format(path, at(&format!("frames[{f}]")), expected));
+            }
+            if let Some(i) = frame.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                return Err(MeshFileError::format(
+                    path,
+                    at(&format!("frames[{f}][{i}]")),
+                    "finite coordinates",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The glTF mesh (base attributes, one POSITION + NORMAL target per frame) and its default
+    /// weights.
+    pub(crate) fn mesh_json(&self, buffer: &mut Buffer) -> Value {
+        let split = split_uv_seams(&self.mesh);
+        let source: Vec<usize> = split.source.iter().map(|&v| v as usize).collect();
+        let unit = |n: [f32; 3]| if n == [0.0; 3] { [0.0, 1.0, 0.0] } else { n };
+        let base_normals: Vec<[f32; 3]> =
+            vertex_normals(&self.mesh.positions, &self.mesh.faces).into_iter().map(unit).collect();
+        let pick = |values: &[[f32; 3]]| -> Vec<[f32; 3]> { source.iter().map(|&v| values[v]).collect() };
+        let mut attributes = json!({
+            "POSITION": buffer.floats(&pick(&self.mesh.positions), true, Some(ARRAY_BUFFER)),
+            "NORMAL": buffer.floats(&pick(&base_normals), false, Some(ARRAY_BUFFER)),
+        });
+        if let Some(uv) = &split.uv {
+            // glTF's texture origin is the top-left corner: v_gltf = 1 − v_obj.
+            let flipped: Vec<[f32; 2]> = uv.iter().map(|t| [t[0], 1.0 - t[1]]).collect();
+            attributes["TEXCOORD_0"] = json!(buffer.floats(&flipped, false, Some(ARRAY_BUFFER)));
+        }
+        let delta = |a: &[[f32; 3]], b: &[[f32; 3]]| -> Vec<[f32; 3]> {
+            source.iter().map(|&v| std::array::from_fn(|d| a[v][d] - b[v][d])).collect()
+        };
+        let targets: Vec<Value> = self
+            .frames
+            .iter()
+            .map(|frame| {
+                let normals: Vec<[f32; 3]> =
+                    vertex_normals(frame, &self.mesh.faces).into_iter().map(unit).collect();
+                json!({
+                    "POSITION": buffer.floats(&delta(frame, &self.mesh.positions), true, None),
+                    "NORMAL": buffer.floats(&delta(&normals, &base_normals), false, None),
+                })
+            })
+            .collect();
+        let indices: Vec<[u32; 1]> = split.faces.iter().flatten().map(|&i| [i]).collect();
+        let indices = buffer.ints(&indices, Int::U32, Some(ELEMENT_ARRAY_BUFFER));
+        json!({
+            "name": self.name,
+            "primitives": [{ "attributes": attributes, "indices": indices, "mode": 4, "targets": targets }],
+            "weights": vec![0.0f32; self.frames.len()],
+        })
+    }
+
+    /// The sampler (LINEAR, one-hot keys) that plays the frames on the mesh's weights.
+    pub(crate) fn weights_sampler(&self, buffer: &mut Buffer) -> Value {
+        let frames = self.frames.len();
+        let times: Vec<[f32; 1]> = (0..frames).map(|k| [(k as f64 / self.fps as f64) as f32]).collect();
+        let input = buffer.floats(&times, true, None);
+        let keys: Vec<[f32; 1]> =
+            (0..frames).flat_map(|k| (0..frames).map(move |t| [if t == k { 1.0 } else { 0.0 }])).collect();
+        let output = buffer.floats(&keys, false, None);
+        json!({ "input": input, "output": output, "interpolation": "LINEAR" })
+    }
+}
