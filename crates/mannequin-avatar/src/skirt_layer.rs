@@ -2,9 +2,10 @@
 //! with per-leg skinning cannot span that gap: fitted to a dress it becomes two inflated legs
 //! (synthetic dress subject: 26.3 dB, Chamfer 2.5 cm). The layer is a separate garment mesh over
 //! the body, as in the thesis's MGN-style garments: a surface of revolution from the waist
-//! (the SPINE1 joint's height) to a hem found in the masks, skinned from the pelvis at the waist
-//! to the pelvis and nearer hip at the hem, with each vertex's radius carved to the visual hull
-//! of the training masks. The offset field then refines it like the rest of the mesh.
+//! (the SPINE1 joint's height) to a hem found in the masks, its skinning carried from the body by
+//! Gaussian RBFs (NGD §3.5), with each vertex's radius carved to the visual hull of the training
+//! masks. The offset field then refines it like the rest of the mesh. Nothing here comes from the
+//! synthetic generator, whose own skirts are built and skinned another way.
 
 use glam::{Affine3A, DVec3, Vec3};
 use rayon::prelude::*;
@@ -12,7 +13,10 @@ use rayon::prelude::*;
 use mannequin_body::kinematics::{skinning_transforms, world_transforms};
 use mannequin_body::lbs::frame_rotations;
 use mannequin_body::smpl_joint::{L_ANKLE, L_HIP, L_KNEE, PELVIS, R_ANKLE, R_HIP, R_KNEE, SPINE1};
-use mannequin_data::synth::skirt::{RingLayout, Skirt, build_skirt, lower_body};
+use mannequin_body::weight_transfer::transfer_weights;
+use mannequin_mesh::UvLayout;
+use mannequin_mesh::gltf::influences::top_four;
+use mannequin_mesh::ring_tube::RingLayout;
 
 use crate::canonical::Canonical;
 use crate::error::AvatarError;
@@ -40,6 +44,14 @@ const PROVISIONAL: (usize, usize) = (64, 28);
 const EDGE: f32 = 0.015;
 /// Below the hem, the body's offsets are released over this height (m).
 const HEM_MARGIN: f32 = 0.08;
+/// Width of the GRBF skinning kernel (m): about a thigh's radius, so a point over the gap
+/// between the legs blends both.
+const SKIN_SIGMA: f32 = 0.05;
+/// Half-width of the strip around a ray in which body points count towards its outline (m).
+const OUTLINE_STRIP: f32 = 0.02;
+/// The layer's least radius (m), where no body point lies along a ray (over the gap between
+/// the legs), so every vertex has a direction to carve along.
+const MIN_RADIUS: f32 = 0.05;
 
 /// Whether to add the layer: when the masks show a skirt, or never.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
@@ -55,6 +67,19 @@ impl std::str::FromStr for SkirtMode {
         <Self as clap::ValueEnum>::from_str(s, false)
             .map_err(|_| format!("unknown skirt mode '{s}' (expected auto or off)"))
     }
+}
+
+/// A tube of rings around the pelvis with its skinning, in the canonical body's rest frame.
+pub struct Skirt {
+    /// Rest positions, ring-major from the waist down.
+    pub positions: Vec<[f32; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    pub uv: UvLayout,
+    /// Skinning weights, V × J row-major, from the body by GRBF.
+    pub weights: Vec<f32>,
+    /// The four strongest joints of each vertex, for testing points against the masks.
+    influences: Vec<([u16; 4], [f32; 4])>,
+    pub layout: RingLayout,
 }
 
 /// The fitted layer, in the canonical body's rest frame.
@@ -97,13 +122,18 @@ impl<'a> Silhouettes<'a> {
         Self { views }
     }
 
-    /// Share of views in which the rest-pose point `p`, skinned by `weights`, lands off the mask.
-    fn outside(&self, p: Vec3, weights: &[(usize, f32); 3]) -> f32 {
+    /// Share of views in which the rest-pose point `p`, skinned by `influences`, lands off the
+    /// mask.
+    fn outside(&self, p: Vec3, (joints, weights): &([u16; 4], [f32; 4])) -> f32 {
         let off = self
             .views
             .iter()
             .filter(|(view, transforms)| {
-                let posed: Vec3 = weights.iter().map(|&(j, w)| w * transforms[j].transform_point3(p)).sum();
+                let posed: Vec3 = joints
+                    .iter()
+                    .zip(weights)
+                    .map(|(&j, &w)| w * transforms[j as usize].transform_point3(p))
+                    .sum();
                 let world = (posed + Vec3::from(view.transl)).as_dvec3();
                 !on_mask(view, world)
             })
@@ -114,13 +144,13 @@ impl<'a> Silhouettes<'a> {
     /// The largest radius along the rest-pose ray from `centre` through `vertex` (horizontally)
     /// whose point is inside the hull, searched out to `REACH` past the vertex; `None` when the
     /// whole ray is outside.
-    fn carve(&self, centre: Vec3, vertex: Vec3, weights: &[(usize, f32); 3]) -> Option<f32> {
+    fn carve(&self, centre: Vec3, vertex: Vec3, influences: &([u16; 4], [f32; 4])) -> Option<f32> {
         let d = horizontal(vertex, centre);
         let (r0, dir) = (d.length(), d.normalize_or_zero());
         let steps = ((r0 + REACH) / STEP) as usize;
         (1..=steps).map(|k| k as f32 * STEP).rev().find(|&r| {
             let p = Vec3::new(centre.x, vertex.y, centre.z) + r * dir;
-            self.outside(p, weights) <= DISAGREE
+            self.outside(p, influences) <= DISAGREE
         })
     }
 }
@@ -144,7 +174,7 @@ fn carve_all(hull: &Silhouettes, skirt: &Skirt, centre: Vec3) -> Vec<Option<f32>
     skirt
         .positions
         .par_iter()
-        .zip(&skirt.weights)
+        .zip(&skirt.influences)
         .map(|(p, w)| hull.carve(centre, Vec3::from(*p), w))
         .collect()
 }
@@ -183,6 +213,38 @@ fn skirt_rings(carved: &[Option<f32>], layout: &RingLayout) -> usize {
     (0..layout.rings.len()).take_while(|&r| kept(r)).count()
 }
 
+/// A layer on `layout` from `waist` down to `hem` around the vertical axis through `centre`, each
+/// vertex at the body's outline along its ray (at least `MIN_RADIUS` out), skinned from the body.
+fn ring_skirt(body: &Canonical, centre: Vec3, (waist, hem): (f32, f32), layout: &RingLayout) -> Skirt {
+    let length = waist - hem;
+    let below_waist: Vec<Vec3> =
+        body.vertices.iter().map(|&p| Vec3::from(p)).filter(|p| p.y < waist).collect();
+    let band = 0.5 * length / layout.rings.len().max(2) as f32 + OUTLINE_STRIP;
+    let mut positions = Vec::with_capacity(layout.vertex_count());
+    for (&s, &n) in layout.rings.iter().zip(&layout.segments) {
+        let y = waist - s * length;
+        let near: Vec<Vec3> =
+            below_waist.iter().filter(|p| (p.y - y).abs() <= band).map(|&p| horizontal(p, centre)).collect();
+        for k in 0..n {
+            let (sin, cos) = (std::f32::consts::TAU * k as f32 / n as f32).sin_cos();
+            let ray = Vec3::new(cos, 0.0, sin);
+            // The farthest body point along the ray, within a strip around it.
+            let outline = near
+                .iter()
+                .filter(|h| h.cross(ray).length() <= OUTLINE_STRIP)
+                .map(|h| h.dot(ray))
+                .fold(MIN_RADIUS, f32::max);
+            positions.push((Vec3::new(centre.x, y, centre.z) + outline * ray).to_array());
+        }
+    }
+    let j = body.num_joints();
+    let weights = transfer_weights(&body.vertices, &body.weights, j, &positions, SKIN_SIGMA);
+    let influences =
+        weights.chunks_exact(j).map(|row| top_four(row).unwrap_or(([0; 4], [1.0, 0.0, 0.0, 0.0]))).collect();
+    let (faces, uv) = layout.tube();
+    Skirt { positions, faces, uv, weights, influences, layout: layout.clone() }
+}
+
 /// Rings a triangle's height apart (`EDGE`·√3/2), each with as many vertices as keep `EDGE`
 /// between them at its radius, so the layer's triangles are near-equilateral and one size from
 /// the narrow waist to the wide hem. With 96 vertices on every ring the hem's edges were 2.5 cm
@@ -216,13 +278,12 @@ pub fn fit_skirt(
     let (waist, centre) = (y(SPINE1), Vec3::from(body.joints[PELVIS]));
     let ankles = 0.5 * (y(L_ANKLE) + y(R_ANKLE));
     let mid_thigh = 0.5 * (0.5 * (y(L_HIP) + y(R_HIP)) + 0.5 * (y(L_KNEE) + y(R_KNEE)));
-    let inside = lower_body(&body.vertices, &body.weights, body.num_joints());
     let hull = Silhouettes::new(body, views);
 
     // A long provisional skirt finds the hem: the last ring that keeps its radius.
     let lowest = ankles + ANKLE_CLEARANCE;
     let coarse = RingLayout::uniform(PROVISIONAL.0, PROVISIONAL.1);
-    let provisional = build_skirt(&inside, centre, (waist, lowest), (0.0, 0.0), &coarse);
+    let provisional = ring_skirt(body, centre, (waist, lowest), &coarse);
     let carved = carve_all(&hull, &provisional, centre);
     let rings = skirt_rings(&carved, &coarse);
     let hem_s = coarse.rings[rings.saturating_sub(1)];
@@ -243,7 +304,7 @@ pub fn fit_skirt(
         let next = profile[(i + 1).min(PROVISIONAL.1)];
         profile[i] * (1.0 - t) + next * t
     });
-    let mut skirt = build_skirt(&inside, centre, (waist, hem), (0.0, 0.0), &layout);
+    let mut skirt = ring_skirt(body, centre, (waist, hem), &layout);
     let carved = carve_all(&hull, &skirt, centre);
     for ((k, p), ring) in skirt.positions.iter_mut().enumerate().zip(layout.ring_of_vertices()) {
         // Smooth along the ring ([1, 2, 1] / 4) over the pixel steps of the carving, and never
@@ -305,13 +366,8 @@ impl Canonical {
         }
         self.vertices.extend_from_slice(&layer.skirt.positions);
         self.faces.extend(layer.skirt.faces.iter().map(|f| f.map(|i| i + v as u32)));
-        for w in &layer.skirt.weights {
-            let mut row = vec![0.0f32; j];
-            for &(joint, weight) in w {
-                row[joint] += weight;
-            }
-            self.weights.extend(row);
-        }
+        debug_assert_eq!(layer.skirt.weights.len(), added * j);
+        self.weights.extend_from_slice(&layer.skirt.weights);
         self
     }
 }

@@ -14,6 +14,7 @@ pub mod skinned_export;
 pub mod smpl_joint;
 pub mod smpl_npz;
 pub mod walk_cycle;
+pub mod weight_transfer;
 
 pub use error::BodyError;
 pub use lbs::{PosedFrames, ShapedBody, forward, pose_frames, shape_body};

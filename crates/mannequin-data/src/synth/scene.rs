@@ -9,7 +9,7 @@ use mannequin_mesh::{TriMesh, UvLayout};
 use rayon::prelude::*;
 
 use super::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoothstep};
-use super::skirt::{RingLayout, Skirt, build_skirt, lower_body, skirt_span};
+use super::skirt::{Skirt, build_skirt, lower_body, skirt_span};
 use super::subject::{Outfit, Subject};
 use super::texture::{BakeInput, SurfacePoint, bake};
 use crate::Camera;
@@ -19,6 +19,7 @@ use crate::maps::{DepthMap, NormalMap};
 use crate::mesh_raster::{RasterMesh, Shading, rasterize};
 use crate::rng::SplitMix64;
 use mannequin_body::smpl_joint as joint;
+use mannequin_mesh::ring_tube::RingLayout;
 
 /// Texture sizes: the body's UV atlas and the skirt's strip beside it.
 const BODY_TEXTURE: usize = 1024;

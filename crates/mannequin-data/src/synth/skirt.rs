@@ -8,6 +8,7 @@ use super::clothing::smoothstep;
 use super::subject::Outfit;
 use mannequin_body::smpl_joint::{L_HIP, L_KNEE, PELVIS, R_HIP, R_KNEE, SPINE1};
 use mannequin_mesh::UvLayout;
+use mannequin_mesh::ring_tube::RingLayout;
 
 /// Angular bins for measuring the body's cross-section.
 const BINS: usize = 48;
@@ -20,53 +21,6 @@ pub struct Skirt {
     /// Per vertex, `(joint, weight)` pairs summing to one.
     pub weights: Vec<[(usize, f32); 3]>,
     pub layout: RingLayout,
-}
-
-/// Where the skirt's vertices sit: rings at fractions of the length from the waist (0) to the
-/// hem (1), increasing, each with its own number of vertices, so a flared skirt can keep its
-/// triangles the same size from the narrow waist to the wide hem.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RingLayout {
-    pub rings: Vec<f32>,
-    /// Vertices around each ring.
-    pub segments: Vec<usize>,
-    /// Index of each ring's first vertex.
-    starts: Vec<usize>,
-}
-
-impl RingLayout {
-    /// Rings at `rings` with `segments[r]` vertices each (at least 3).
-    pub fn new(rings: Vec<f32>, segments: Vec<usize>) -> Self {
-        assert_eq!(rings.len(), segments.len(), "one segment count per ring");
-        assert!(segments.iter().all(|&n| n >= 3), "a ring has at least 3 vertices");
-        let starts = segments.iter().scan(0, |next, &n| Some(std::mem::replace(next, *next + n))).collect();
-        Self { rings, segments, starts }
-    }
-
-    /// `rings + 1` evenly spaced rings of `segments` vertices: the generator's 64 × 29 grid.
-    pub fn uniform(segments: usize, rings: usize) -> Self {
-        Self::new((0..=rings).map(|r| r as f32 / rings as f32).collect(), vec![segments; rings + 1])
-    }
-
-    /// The last ring at or above `fraction` of the length below the waist.
-    pub fn ring_at(&self, fraction: f32) -> usize {
-        self.rings.partition_point(|&s| s <= fraction).saturating_sub(1).min(self.rings.len() - 1)
-    }
-
-    /// Index of vertex `segment` (taken around the ring) of ring `ring`.
-    pub fn vertex(&self, ring: usize, segment: usize) -> usize {
-        self.starts[ring] + segment % self.segments[ring]
-    }
-
-    /// The vertex of ring `ring` nearest the angle `turn` (in turns, 0 to 1).
-    pub fn nearest(&self, ring: usize, turn: f32) -> usize {
-        self.vertex(ring, (turn.rem_euclid(1.0) * self.segments[ring] as f32).round() as usize)
-    }
-
-    /// The ring of each vertex, in vertex order.
-    pub fn ring_of_vertices(&self) -> impl Iterator<Item = usize> + '_ {
-        self.segments.iter().enumerate().flat_map(|(r, &n)| std::iter::repeat_n(r, n))
-    }
 }
 
 /// Waist and hem heights of `outfit`'s skirt on a body with rest `joints`, if it has one: from
@@ -127,7 +81,6 @@ pub fn build_skirt(
     }
     let mut positions = Vec::new();
     let mut weights = Vec::new();
-    let mut coords = Vec::new();
     for ((ring, &s), &segments) in radius.iter().zip(&layout.rings).zip(&layout.segments) {
         let y = waist - s * length;
         for k in 0..segments {
@@ -145,38 +98,9 @@ pub fn build_skirt(
             let legs = 0.5 * smoothstep(0.0, 1.0, s);
             weights.push([(PELVIS, 1.0 - legs), (L_HIP, legs * side), (R_HIP, legs * (1.0 - side))]);
         }
-        for k in 0..=segments {
-            coords.push([k as f32 / segments as f32, 1.0 - s]);
-        }
     }
-    // Between two rings, walk round both and step whichever ring's next vertex comes first (the
-    // lower ring on ties, which on equal rings gives each quad the diagonal from upper k to lower
-    // k + 1). Counter-clockwise seen from outside, so face normals point outward.
-    let mut faces = Vec::new();
-    let mut uv_faces = Vec::new();
-    let mut uv_start = 0;
-    for r in 0..rings - 1 {
-        let (n_up, n_down) = (layout.segments[r], layout.segments[r + 1]);
-        let up = |k: usize| layout.vertex(r, k) as u32;
-        let down = |k: usize| layout.vertex(r + 1, k) as u32;
-        let t_up = |k: usize| (uv_start + k) as u32;
-        let t_down = |k: usize| (uv_start + n_up + 1 + k) as u32;
-        let (mut i, mut j) = (0, 0);
-        while i < n_up || j < n_down {
-            let step_down = j < n_down && (i == n_up || (j + 1) * n_up <= (i + 1) * n_down);
-            if step_down {
-                faces.push([up(i), down(j + 1), down(j)]);
-                uv_faces.push([t_up(i), t_down(j + 1), t_down(j)]);
-                j += 1;
-            } else {
-                faces.push([up(i), up(i + 1), down(j)]);
-                uv_faces.push([t_up(i), t_up(i + 1), t_down(j)]);
-                i += 1;
-            }
-        }
-        uv_start += n_up + 1;
-    }
-    Skirt { positions, faces, uv: UvLayout { coords, faces: uv_faces }, weights, layout: layout.clone() }
+    let (faces, uv) = layout.tube();
+    Skirt { positions, faces, uv, weights, layout: layout.clone() }
 }
 
 #[cfg(test)]
@@ -184,7 +108,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn skirt_encloses_the_body_and_faces_outward() {
+    fn skirt_encloses_the_body() {
         // A body cylinder of radius 0.15 around (0.1, ·, 0.0), from y = 0 to 1.
         let body: Vec<Vec3> = (0..2000)
             .map(|i| {
@@ -202,27 +126,6 @@ mod tests {
                 let r = ((p[0] - 0.1).powi(2) + p[2].powi(2)).sqrt();
                 assert!(r >= 0.16 - 1e-4, "{p:?} radius {r}");
             }
-            let n = mannequin_mesh::normals::face_normals(&s.positions, &s.faces);
-            for (f, n) in s.faces.iter().zip(&n) {
-                let c = f.iter().fold(Vec3::ZERO, |a, &i| a + Vec3::from(s.positions[i as usize])) / 3.0;
-                let out = Vec3::new(c.x - 0.1, 0.0, c.z).normalize();
-                assert!(Vec3::from(*n).dot(out) > 0.5);
-            }
-            // An open tube: every edge is shared by two faces except the waist's and the hem's,
-            // and the UV faces follow the mesh faces.
-            let mut edges = std::collections::HashMap::new();
-            for f in &s.faces {
-                for k in 0..3 {
-                    let (a, b) = (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]));
-                    *edges.entry((a, b)).or_insert(0) += 1;
-                }
-            }
-            let boundary = edges.values().filter(|&&c| c == 1).count();
-            let (top, bottom) = (layout.segments[0], *layout.segments.last().unwrap());
-            assert_eq!(boundary, top + bottom);
-            assert!(edges.values().all(|&c| c <= 2));
-            assert_eq!(s.positions.len() + s.faces.len(), edges.len(), "V − E + F = 0 for a tube");
-            assert_eq!(s.uv.faces.len(), s.faces.len());
             for w in &s.weights {
                 assert!((w.iter().map(|x| x.1).sum::<f32>() - 1.0).abs() < 1e-6);
             }
