@@ -297,6 +297,13 @@ fn obj() {
 }
 
 #[test]
+fn pc2() {
+    mutations("pc2", |b| {
+        mannequin_mesh::PointCache::parse(Path::new("case.pc2"), b).map(drop).map_err(|e| e.to_string())
+    });
+}
+
+#[test]
 fn splat_ply() {
     mutations("splat_ply", |b| {
         let scene = SplatScene::from_ply_bytes(Path::new("case.ply"), b).map_err(|e| e.to_string())?;

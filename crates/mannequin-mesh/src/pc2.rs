@@ -22,6 +22,9 @@ impl PointCache {
     /// Writes the cache to `path` atomically.
     pub fn write(&self, path: &Path) -> Result<(), MeshFileError> {
         let vertices = self.frames.first().map_or(0, Vec::len);
+        if vertices == 0 {
+            return Err(MeshFileError::format(path, "frames", "at least one frame of at least one vertex"));
+        }
         if let Some(f) = self.frames.iter().position(|frame| frame.len() != vertices) {
             let expected = format!("{vertices} vertices (as frame 0), found {}", self.frames[f].len());
             return Err(MeshFileError::format(path, format!("frame {f}"), expected));
@@ -49,7 +52,8 @@ impl PointCache {
         Self::parse(path, &bytes)
     }
 
-    fn parse(path: &Path, bytes: &[u8]) -> Result<Self, MeshFileError> {
+    /// Parses the bytes of a cache read from `path` (named in errors).
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, MeshFileError> {
         let fail = |at: &str, expected: String| MeshFileError::format(path, at, expected);
         if bytes.len() < HEADER || &bytes[..12] != MAGIC {
             return Err(fail("header", "a 32-byte header starting \"POINTCACHE2\\0\"".into()));
@@ -61,11 +65,9 @@ impl PointCache {
         }
         let (vertices, frames) = (i32::from_le_bytes(word(16)), i32::from_le_bytes(word(28)));
         let (start, sampling) = (f32::from_le_bytes(word(20)), f32::from_le_bytes(word(24)));
-        let (Ok(v), Ok(f)) = (usize::try_from(vertices), usize::try_from(frames)) else {
-            return Err(fail(
-                "counts",
-                format!("non-negative counts, found {vertices} vertices, {frames} frames"),
-            ));
+        let (Ok(v @ 1..), Ok(f)) = (usize::try_from(vertices), usize::try_from(frames)) else {
+            let found = format!("found {vertices} vertices, {frames} frames");
+            return Err(fail("counts", format!("at least one vertex and no negative count, {found}")));
         };
         let body = v.checked_mul(f).and_then(|n| n.checked_mul(12));
         if body != Some(bytes.len() - HEADER) {
@@ -78,7 +80,7 @@ impl PointCache {
                 std::array::from_fn(|d| f32::from_le_bytes(p[4 * d..4 * d + 4].try_into().expect("4 bytes")))
             })
             .collect();
-        let frames = if v == 0 { vec![Vec::new(); f] } else { points.chunks(v).map(<[_]>::to_vec).collect() };
+        let frames = points.chunks(v).map(<[_]>::to_vec).collect();
         Ok(Self { start, sampling, frames })
     }
 }
@@ -109,6 +111,13 @@ mod tests {
         std::fs::write(&path, &bytes[..bytes.len() - 4]).unwrap();
         let e = PointCache::read(&path).unwrap_err().to_string();
         assert!(e.contains("2 vertices × 2 frames × 12 bytes, found 44 bytes"), "{e}");
+        // No vertices and 2³¹ − 1 frames would be an empty body with a huge list to make.
+        let mut empty = bytes[..32].to_vec();
+        empty[16..20].copy_from_slice(&0i32.to_le_bytes());
+        empty[28..32].copy_from_slice(&i32::MAX.to_le_bytes());
+        std::fs::write(&path, &empty).unwrap();
+        let e = PointCache::read(&path).unwrap_err().to_string();
+        assert!(e.contains("at least one vertex"), "{e}");
         std::fs::remove_file(&path).unwrap();
     }
 }
