@@ -1,2 +1,25 @@
 //! XPBD cloth (thesis §3.3): a garment mesh's vertices as particles, held by stretch and dihedral
 //! bending constraints, kept off itself and off an animated body.
+
+mod bending;
+mod cloth;
+mod coloured_sweep;
+mod colouring;
+mod dihedral;
+mod error;
+mod garment_check;
+mod material;
+mod phase_times;
+mod settings;
+mod simulator;
+mod state;
+mod stretch;
+mod topology;
+
+pub use cloth::Cloth;
+pub use error::ClothError;
+pub use material::{MATERIAL_NAMES, Material};
+pub use phase_times::PhaseTimes;
+pub use settings::Settings;
+pub use simulator::Simulator;
+pub use state::ClothState;

@@ -1,0 +1,27 @@
+//! Cloth errors: one line each, naming the field at fault, so a caller can prefix its file name.
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ClothError {
+    #[error("material: unknown name {name:?}; the materials are {}", crate::material::MATERIAL_NAMES.join(", "))]
+    UnknownMaterial { name: String },
+    #[error("{field}: {reason}")]
+    Invalid { field: String, reason: String },
+    #[error("{field}[{index}] is not finite")]
+    NonFiniteInput { field: &'static str, index: usize },
+    #[error("faces[{face}] refers to vertex {index}, but there are {count} vertices")]
+    FaceIndex { face: usize, index: u32, count: usize },
+    #[error("faces[{face}] is degenerate (zero area)")]
+    DegenerateFace { face: usize },
+    #[error("faces: edge ({a}, {b}) is shared by {count} triangles; a cloth edge may have at most 2")]
+    NonManifoldEdge { a: u32, b: u32, count: usize },
+    #[error("pins[{index}] = {vertex} is out of range: the garment has {count} vertices")]
+    PinIndex { index: usize, vertex: u32, count: usize },
+    #[error("the simulation blew up in frame {frame}: particle {particle} is not finite")]
+    NonFinite { frame: u64, particle: usize },
+}
+
+impl ClothError {
+    pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Self::Invalid { field: field.into(), reason: reason.into() }
+    }
+}

@@ -1,0 +1,64 @@
+//! Stretch constraints (Eq. 3.20), C = |p₁ − p₂| − l₀ on every edge, projected by XPBD (Eqs.
+//! 3.34–3.35): Δλ = (−C − α̃λ) / (w₁ + w₂ + α̃), with α̃ = α/Δt².
+
+use std::ops::Range;
+
+use glam::Vec3;
+
+use crate::coloured_sweep::sweep;
+use crate::colouring::greedy_colouring;
+
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct StretchConstraints {
+    /// Edges in colour order, each with its rest length.
+    pub edges: Vec<([u32; 2], f32)>,
+    pub colours: Vec<Range<usize>>,
+    /// α in m/N, the same for every edge.
+    pub compliance: f32,
+}
+
+impl StretchConstraints {
+    pub fn new(rest: &[[f32; 3]], edges: &[[u32; 2]], compliance: f32) -> Self {
+        let colouring = greedy_colouring(edges, rest.len());
+        let edges = colouring
+            .order
+            .iter()
+            .map(|&k| {
+                let [a, b] = edges[k];
+                (edges[k], (Vec3::from(rest[a as usize]) - Vec3::from(rest[b as usize])).length())
+            })
+            .collect();
+        Self { edges, colours: colouring.colours, compliance }
+    }
+
+    pub fn len(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// One sweep over every edge; `lambda` holds the multipliers of this substep, in colour order.
+    pub fn project(&self, positions: &mut [[f32; 3]], inverse_mass: &[f32], lambda: &mut [f32], dt: f32) {
+        let alpha = self.compliance / (dt * dt);
+        sweep(&self.colours, &self.edges, lambda, positions, |&([a, b], rest), lambda, x| {
+            let (wa, wb) = (inverse_mass[a as usize], inverse_mass[b as usize]);
+            let denominator = wa + wb + alpha;
+            if wa + wb == 0.0 {
+                return;
+            }
+            // SAFETY: a and b belong to this edge alone within its colour.
+            let (pa, pb) = unsafe { (x.get(a), x.get(b)) };
+            let d = pa - pb;
+            let length = d.length();
+            if length <= f32::MIN_POSITIVE {
+                return;
+            }
+            let n = d / length;
+            let delta = (rest - length - alpha * *lambda) / denominator;
+            *lambda += delta;
+            // SAFETY: as above.
+            unsafe {
+                x.set(a, pa + wa * delta * n);
+                x.set(b, pb - wb * delta * n);
+            }
+        });
+    }
+}
