@@ -16,8 +16,8 @@ pub enum ClothError {
     NonManifoldEdge { a: u32, b: u32, count: usize },
     #[error("pins[{index}] = {vertex} is out of range: the garment has {count} vertices")]
     PinIndex { index: usize, vertex: u32, count: usize },
-    #[error("the simulation blew up in frame {frame}: particle {particle} is not finite")]
-    NonFinite { frame: u64, particle: usize },
+    #[error("the simulation blew up: particle {particle} is no longer finite")]
+    NonFinite { particle: usize },
 }
 
 impl ClothError {

@@ -1,7 +1,12 @@
 //! XPBD cloth (thesis §3.3): a garment mesh's vertices as particles, held by stretch and dihedral
 //! bending constraints, kept off itself and off an animated body.
 
+mod attachment;
 mod bending;
+mod body;
+mod body_contacts;
+mod box_hash;
+mod closest_point;
 mod cloth;
 mod coloured_sweep;
 mod colouring;
@@ -16,6 +21,8 @@ mod state;
 mod stretch;
 mod topology;
 
+pub use attachment::Attachment;
+pub use body::Body;
 pub use cloth::Cloth;
 pub use error::ClothError;
 pub use material::{MATERIAL_NAMES, Material};

@@ -7,6 +7,9 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::attachment::{Attachment, check_attachments};
+use crate::body::Body;
+use crate::body_contacts::BodyCollider;
 use crate::cloth::Cloth;
 use crate::error::ClothError;
 use crate::phase_times::PhaseTimes;
@@ -16,22 +19,39 @@ use crate::state::ClothState;
 pub struct Simulator {
     cloth: Cloth,
     settings: Settings,
+    /// The cloth's inverse masses, with attached particles made kinematic (0).
+    inverse_mass: Vec<f32>,
+    body: Option<BodyCollider>,
+    attachments: Vec<Attachment>,
     positions: Vec<[f32; 3]>,
     velocities: Vec<[f32; 3]>,
     /// Positions at the start of the current substep.
     previous: Vec<[f32; 3]>,
     stretch_lambda: Vec<f32>,
     bending_lambda: Vec<f32>,
-    frame: u64,
     times: PhaseTimes,
 }
 
 impl Simulator {
-    /// A simulator starting from the cloth's rest shape at rest.
-    pub fn new(cloth: Cloth, settings: Settings) -> Result<Self, ClothError> {
+    /// A simulator starting from the cloth's rest shape at rest, colliding with `body` if given,
+    /// with `attachments` (which need a body) following it.
+    pub fn new(
+        cloth: Cloth,
+        body: Option<Body>,
+        attachments: Vec<Attachment>,
+        settings: Settings,
+    ) -> Result<Self, ClothError> {
         settings.validate()?;
         let n = cloth.particle_count();
+        check_attachments(&attachments, n, body.as_ref())?;
+        let mut inverse_mass = cloth.inverse_mass.clone();
+        for a in &attachments {
+            inverse_mass[a.particle as usize] = 0.0;
+        }
         Ok(Self {
+            inverse_mass,
+            body: body.map(BodyCollider::new),
+            attachments,
             positions: cloth.rest.clone(),
             velocities: vec![[0.0; 3]; n],
             previous: cloth.rest.clone(),
@@ -39,34 +59,58 @@ impl Simulator {
             bending_lambda: vec![0.0; cloth.bending.len()],
             cloth,
             settings,
-            frame: 0,
             times: PhaseTimes::default(),
         })
     }
 
-    /// Advances the cloth by one frame of `frame_dt` seconds.
-    pub fn step_frame(&mut self, frame_dt: f32) -> Result<(), ClothError> {
+    /// Advances the cloth by one frame of `frame_dt` seconds, while the body moves from the
+    /// vertex positions `body_start` to `body_end` (both empty when there is no body).
+    pub fn step_frame(
+        &mut self,
+        body_start: &[[f32; 3]],
+        body_end: &[[f32; 3]],
+        frame_dt: f32,
+    ) -> Result<(), ClothError> {
         if !(frame_dt.is_finite() && frame_dt > 0.0) {
             return Err(ClothError::invalid("frame_dt", format!("{frame_dt} is not a positive duration")));
         }
-        let dt = frame_dt / self.settings.substeps as f32;
-        for _ in 0..self.settings.substeps {
-            self.substep(dt);
+        let substeps = self.settings.substeps;
+        match &mut self.body {
+            Some(body) => body.begin_frame(body_start, body_end, substeps, self.settings.body_margin)?,
+            None if body_start.is_empty() && body_end.is_empty() => {}
+            None => {
+                return Err(ClothError::invalid(
+                    "body_start",
+                    "body positions given, but the simulator has no body",
+                ));
+            }
         }
-        self.frame += 1;
+        let dt = frame_dt / substeps as f32;
+        for k in 0..substeps {
+            self.substep(k, dt);
+        }
         match self.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-            Some(particle) => Err(ClothError::NonFinite { frame: self.frame - 1, particle }),
+            Some(particle) => Err(ClothError::NonFinite { particle }),
             None => Ok(()),
         }
     }
 
-    fn substep(&mut self, dt: f32) {
+    fn substep(&mut self, k: u32, dt: f32) {
+        if let Some(body) = &mut self.body {
+            let t = Instant::now();
+            body.advance(k);
+            self.times.body_contacts += t.elapsed();
+            let t = Instant::now();
+            if body.rebuild_if_due(k) {
+                self.times.hashing += t.elapsed();
+            }
+        }
         let t = Instant::now();
         self.predict(dt);
         self.times.prediction += t.elapsed();
         self.stretch_lambda.fill(0.0);
         self.bending_lambda.fill(0.0);
-        let w = &self.cloth.inverse_mass;
+        let w = &self.inverse_mass;
         for _ in 0..self.settings.iterations {
             let t = Instant::now();
             self.cloth.stretch.project(&mut self.positions, w, &mut self.stretch_lambda, dt);
@@ -74,17 +118,24 @@ impl Simulator {
             let t = Instant::now();
             self.cloth.bending.project(&mut self.positions, w, &mut self.bending_lambda, dt);
             self.times.bending += t.elapsed();
+            if let Some(body) = &self.body {
+                let t = Instant::now();
+                let (margin, friction) = (self.settings.body_margin, self.cloth.material.friction);
+                body.project(&mut self.positions, &self.previous, w, margin, friction);
+                self.times.body_contacts += t.elapsed();
+            }
         }
         let t = Instant::now();
         self.update_velocities(dt);
         self.times.prediction += t.elapsed();
     }
 
-    /// Eq. 3.13 before the constraints: v ← (v + Δt·g)·e^(−damping·Δt), x ← x + Δt·v.
+    /// Eq. 3.13 before the constraints: v ← (v + Δt·g)·e^(−damping·Δt), x ← x + Δt·v; attached
+    /// particles go to their body points.
     fn predict(&mut self, dt: f32) {
         let g = Vec3::from(self.settings.gravity);
         let keep = (-self.cloth.material.damping * dt).exp();
-        let w = &self.cloth.inverse_mass;
+        let w = &self.inverse_mass;
         (&mut self.positions, &mut self.velocities, &mut self.previous, w).into_par_iter().for_each(
             |(x, v, previous, &w)| {
                 *previous = *x;
@@ -97,6 +148,12 @@ impl Simulator {
                 *x = (Vec3::from(*x) + dt * velocity).to_array();
             },
         );
+        if let Some(body) = &self.body {
+            for a in &self.attachments {
+                let target = a.target(&body.now, &body.body.faces, &body.normals);
+                self.positions[a.particle as usize] = target.to_array();
+            }
+        }
     }
 
     /// Eq. 3.14: the velocity is the substep's displacement over Δt.
@@ -126,11 +183,7 @@ impl Simulator {
     }
 
     pub fn state(&self) -> ClothState {
-        ClothState {
-            frame: self.frame,
-            positions: self.positions.clone(),
-            velocities: self.velocities.clone(),
-        }
+        ClothState { positions: self.positions.clone(), velocities: self.velocities.clone() }
     }
 
     /// Continues from `state`, as saved by [`Simulator::state`] from a simulator of the same cloth.
@@ -149,7 +202,6 @@ impl Simulator {
                 return Err(ClothError::invalid(field, format!("entry {i} is not finite")));
             }
         }
-        self.frame = state.frame;
         self.positions = state.positions;
         self.velocities = state.velocities;
         Ok(())

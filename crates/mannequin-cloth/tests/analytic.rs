@@ -34,13 +34,13 @@ fn a_pendulum_keeps_its_length_and_period() {
         vec![[0, 1, 2]],
     );
     let cloth = Cloth::new(&mesh, &material(1.0, 0.0, 1.0, 0.0), &[0, 1]).unwrap();
-    let mut sim = Simulator::new(cloth, settings(20, [0.0, -G, 0.0])).unwrap();
+    let mut sim = Simulator::new(cloth, None, Vec::new(), settings(20, [0.0, -G, 0.0])).unwrap();
     let dt = 1.0 / 60.0;
     let mut crossings = Vec::new();
     let mut last_z = sim.positions()[2][2];
     let mut worst_length_error = 0.0f32;
     for frame in 1..=360 {
-        sim.step_frame(dt).unwrap();
+        sim.step_frame(&[], &[], dt).unwrap();
         let [_, y, z] = sim.positions()[2];
         worst_length_error = worst_length_error.max(((y * y + z * z).sqrt() - length).abs());
         if last_z > 0.0 && z <= 0.0 {
@@ -72,9 +72,9 @@ fn a_hanging_triangle_stretches_by_compliance_times_tension() {
             vec![[0, 1, 2]],
         );
         let cloth = Cloth::new(&mesh, &material(density, compliance, 1.0, 4.0), &[0, 1]).unwrap();
-        let mut sim = Simulator::new(cloth, settings(20, [0.0, -G, 0.0])).unwrap();
+        let mut sim = Simulator::new(cloth, None, Vec::new(), settings(20, [0.0, -G, 0.0])).unwrap();
         for _ in 0..600 {
-            sim.step_frame(1.0 / 60.0).unwrap();
+            sim.step_frame(&[], &[], 1.0 / 60.0).unwrap();
         }
         // Solve 2·((l − l₀)/α)·√(l² − a²)/l = m·g for the stretched length l by bisection.
         let imbalance = |l: f64| {
@@ -113,9 +113,9 @@ fn a_hanging_sheet_settles_at_its_static_equilibrium() {
     assert!(sag > 0.01, "the test needs a visible sag, got {sag} m");
     let error = |substeps: u32| {
         let cloth = Cloth::new(&mesh, &material(density, compliance, 1e9, 4.0), &pins).unwrap();
-        let mut sim = Simulator::new(cloth, settings(substeps, [0.0, -G, 0.0])).unwrap();
+        let mut sim = Simulator::new(cloth, None, Vec::new(), settings(substeps, [0.0, -G, 0.0])).unwrap();
         for _ in 0..900 {
-            sim.step_frame(1.0 / 60.0).unwrap();
+            sim.step_frame(&[], &[], 1.0 / 60.0).unwrap();
         }
         sim.positions()
             .iter()
@@ -280,7 +280,7 @@ fn a_bent_strip_returns_to_its_rest_angle() {
     }
     let rest = mesh.positions.clone();
     let cloth = Cloth::new(&mesh, &material(0.2, 1e-6, 10.0, 2.0), &[]).unwrap();
-    let mut sim = Simulator::new(cloth, settings(10, [0.0; 3])).unwrap();
+    let mut sim = Simulator::new(cloth, None, Vec::new(), settings(10, [0.0; 3])).unwrap();
     let flat: Vec<[f32; 3]> = (0..rest.len())
         .map(|k| [(k % (cells + 1)) as f32 * spacing, (k / (cells + 1)) as f32 * spacing, 0.0])
         .collect();
@@ -296,7 +296,7 @@ fn a_bent_strip_returns_to_its_rest_angle() {
         assert!(fold_angle(&flat, t1, t2) < 1e-6);
     }
     for _ in 0..300 {
-        sim.step_frame(1.0 / 60.0).unwrap();
+        sim.step_frame(&[], &[], 1.0 / 60.0).unwrap();
     }
     let p = sim.positions();
     for &(t1, t2) in &cross_hinges {
