@@ -3,8 +3,8 @@
 
 use glam::Vec3;
 
+use crate::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 use crate::body::Body;
-use crate::closest_point::{at_barycentric, closest_barycentric};
 use crate::error::ClothError;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,19 +64,6 @@ impl Attachment {
         let [a, b, c] = faces[self.triangle as usize].map(|i| body[i as usize]);
         at_barycentric(self.barycentric, a, b, c) + self.offset * normals[self.triangle as usize]
     }
-}
-
-/// Barycentric coordinates of `p`, a point of the plane of (a, b, c).
-fn plane_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
-    let (v0, v1, v2) = (b - a, c - a, p - a);
-    let (d00, d01, d11, d20, d21) = (v0.dot(v0), v0.dot(v1), v1.dot(v1), v2.dot(v0), v2.dot(v1));
-    let denominator = d00 * d11 - d01 * d01;
-    if denominator == 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let v = (d11 * d20 - d01 * d21) / denominator;
-    let w = (d00 * d21 - d01 * d20) / denominator;
-    [1.0 - v - w, v, w]
 }
 
 /// Refuses attachments naming particles or triangles that do not exist, or non-finite numbers.

@@ -9,9 +9,9 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::barycentric::{at_barycentric, closest_barycentric};
 use crate::body::Body;
 use crate::box_hash::{Aabb, BoxHash};
-use crate::closest_point::{at_barycentric, closest_barycentric};
 use crate::error::ClothError;
 
 /// A window of substeps shares one hash while the body moves less than this fraction of a cell
@@ -31,6 +31,8 @@ pub(crate) struct BodyCollider {
     boxes: Vec<Aabb>,
     hash: BoxHash,
     substeps: u32,
+    /// The farthest any body vertex moves in one substep of this frame.
+    pub step: f32,
     /// Substeps per hash window, and the substep where the current window ends.
     window: u32,
     window_end: u32,
@@ -52,6 +54,7 @@ impl BodyCollider {
             boxes: Vec::new(),
             hash: BoxHash::default(),
             substeps: 1,
+            step: 0.0,
             window: 1,
             window_end: 0,
             cell: 1.0,
@@ -87,6 +90,7 @@ impl BodyCollider {
         self.substeps = substeps;
         let travel = self.start.iter().zip(&self.end).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
         let step = travel / substeps as f32;
+        self.step = step;
         self.reach = margin + 2.0 * step;
         let extents: f32 = self
             .body

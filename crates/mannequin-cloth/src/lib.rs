@@ -2,11 +2,11 @@
 //! bending constraints, kept off itself and off an animated body.
 
 mod attachment;
+mod barycentric;
 mod bending;
 mod body;
 mod body_contacts;
 mod box_hash;
-mod closest_point;
 mod cloth;
 mod coloured_sweep;
 mod colouring;
@@ -15,6 +15,8 @@ mod error;
 mod garment_check;
 mod material;
 mod phase_times;
+pub mod quality;
+mod self_contacts;
 mod settings;
 mod simulator;
 mod state;

@@ -13,6 +13,7 @@ use crate::body_contacts::BodyCollider;
 use crate::cloth::Cloth;
 use crate::error::ClothError;
 use crate::phase_times::PhaseTimes;
+use crate::self_contacts::SelfContacts;
 use crate::settings::Settings;
 use crate::state::ClothState;
 
@@ -23,6 +24,8 @@ pub struct Simulator {
     inverse_mass: Vec<f32>,
     body: Option<BodyCollider>,
     attachments: Vec<Attachment>,
+    /// Present when self-collision is on.
+    contacts: Option<SelfContacts>,
     positions: Vec<[f32; 3]>,
     velocities: Vec<[f32; 3]>,
     /// Positions at the start of the current substep.
@@ -52,6 +55,9 @@ impl Simulator {
             inverse_mass,
             body: body.map(BodyCollider::new),
             attachments,
+            contacts: settings
+                .self_collision
+                .then(|| SelfContacts::new(settings.thickness, &cloth.edges(), n)),
             positions: cloth.rest.clone(),
             velocities: vec![[0.0; 3]; n],
             previous: cloth.rest.clone(),
@@ -85,6 +91,9 @@ impl Simulator {
                 ));
             }
         }
+        if let Some(contacts) = &mut self.contacts {
+            contacts.begin_frame(self.body.as_ref().map_or(0.0, |b| b.step));
+        }
         let dt = frame_dt / substeps as f32;
         for k in 0..substeps {
             self.substep(k, dt);
@@ -107,7 +116,15 @@ impl Simulator {
         }
         let t = Instant::now();
         self.predict(dt);
+        if let Some(contacts) = &self.contacts {
+            contacts.bound_displacements(&mut self.positions, &self.previous, &self.inverse_mass);
+        }
         self.times.prediction += t.elapsed();
+        if let Some(contacts) = &mut self.contacts {
+            let t = Instant::now();
+            contacts.refresh(&self.positions, &self.previous, &self.cloth.faces);
+            self.times.hashing += t.elapsed();
+        }
         self.stretch_lambda.fill(0.0);
         self.bending_lambda.fill(0.0);
         let w = &self.inverse_mass;
@@ -118,6 +135,11 @@ impl Simulator {
             let t = Instant::now();
             self.cloth.bending.project(&mut self.positions, w, &mut self.bending_lambda, dt);
             self.times.bending += t.elapsed();
+            if let Some(contacts) = &mut self.contacts {
+                let t = Instant::now();
+                contacts.project(&mut self.positions, w, &self.cloth.faces);
+                self.times.self_contacts += t.elapsed();
+            }
             if let Some(body) = &self.body {
                 let t = Instant::now();
                 let (margin, friction) = (self.settings.body_margin, self.cloth.material.friction);

@@ -56,6 +56,14 @@ impl Fnv {
     }
 }
 
+/// The FNV-1a hash of `bytes` as 16 hex digits: how a checkpoint tells an edited input file from
+/// the one its run read.
+pub fn hash_bytes(bytes: &[u8]) -> String {
+    let mut h = Fnv::new();
+    h.bytes(bytes);
+    h.hex()
+}
+
 /// Every file under `dir` (recursively) as (path relative to `root` with `/` separators, size),
 /// appended to `out`. A missing `dir` adds nothing.
 fn list_files(root: &Path, dir: &Path, out: &mut Vec<(String, u64)>) -> Result<(), DataError> {

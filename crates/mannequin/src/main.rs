@@ -3,6 +3,7 @@
 
 mod animate;
 mod body;
+mod cloth;
 mod demo;
 mod eval;
 mod export;
@@ -31,6 +32,9 @@ enum Command {
     /// Inspect, pose or animate a body model (SMPL, SMPL-H, SMPL-X or the embedded default).
     #[command(subcommand)]
     Body(body::BodyCommand),
+    /// Simulate a garment on a moving body (XPBD cloth).
+    #[command(subcommand)]
+    Cloth(cloth::ClothCommand),
     /// Write motion files (a procedural walk as AMASS .npz).
     #[command(subcommand)]
     Motion(motion::MotionCommand),
@@ -59,6 +63,7 @@ enum Command {
 fn dispatch(command: Command) -> anyhow::Result<()> {
     match command {
         Command::Body(cmd) => body::run(cmd),
+        Command::Cloth(cmd) => cloth::run(cmd),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
         Command::Demo(args) => demo::run(args),

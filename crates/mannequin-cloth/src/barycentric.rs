@@ -1,6 +1,7 @@
-//! The point of a triangle closest to a given point, with its barycentric coordinates (Ericson,
-//! *Real-Time Collision Detection*, §5.1.5). In an edge's or a vertex's Voronoi region the
-//! coordinates of the other corners are exactly 0, which tells the caller which feature it hit.
+//! Barycentric coordinates on a triangle: of the point closest to a given point (Ericson,
+//! *Real-Time Collision Detection*, §5.1.5), where in an edge's or a vertex's Voronoi region the
+//! coordinates of the other corners are exactly 0, which tells the caller which feature it hit;
+//! and of a point of the triangle's plane.
 
 use glam::Vec3;
 
@@ -50,6 +51,20 @@ pub(crate) fn at_barycentric([u, v, w]: [f32; 3], a: Vec3, b: Vec3, c: Vec3) -> 
     u * a + v * b + w * c
 }
 
+/// Barycentric coordinates of `p`, a point of the plane of (a, b, c); outside the triangle some
+/// are negative. A degenerate triangle gives its first corner.
+pub(crate) fn plane_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    let (v0, v1, v2) = (b - a, c - a, p - a);
+    let (d00, d01, d11, d20, d21) = (v0.dot(v0), v0.dot(v1), v1.dot(v1), v2.dot(v0), v2.dot(v1));
+    let denominator = d00 * d11 - d01 * d01;
+    if denominator <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let v = (d11 * d20 - d01 * d21) / denominator;
+    let w = (d00 * d21 - d01 * d20) / denominator;
+    [1.0 - v - w, v, w]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -79,6 +94,15 @@ mod tests {
         let (bary, point) = closest([0.2, 0.3, -0.7]);
         assert!(bary.iter().all(|&x| x > 0.0));
         assert!((point - Vec3::new(0.2, 0.3, 0.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn plane_coordinates_rebuild_the_point() {
+        let (a, b, c) = (Vec3::new(0.1, -0.2, 0.3), Vec3::new(1.2, 0.1, -0.4), Vec3::new(0.4, 0.9, 0.2));
+        for bary in [[0.2, 0.3, 0.5], [-0.5, 1.2, 0.3], [1.0, 0.0, 0.0]] {
+            let got = plane_barycentric(at_barycentric(bary, a, b, c), a, b, c);
+            assert!((0..3).all(|k| (got[k] - bary[k]).abs() < 1e-5), "{got:?} vs {bary:?}");
+        }
     }
 
     /// Against brute force: no sampled point of the triangle is closer than the one returned.

@@ -1,0 +1,118 @@
+//! Counts pairs of triangles of one mesh that intersect, skipping pairs that share a vertex (those
+//! touch by construction). Candidates come from a uniform grid of the triangles' boxes; each
+//! overlapping pair is tested once, in the cell holding the low corner of the boxes' overlap.
+
+use std::collections::HashMap;
+
+use super::triangle_intersection::{Point, triangles_intersect};
+
+/// The number of intersecting pairs of triangles with no vertex in common. Faces with an index out
+/// of range are ignored.
+pub fn self_intersecting_pairs(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> usize {
+    let faces: Vec<[u32; 3]> =
+        faces.iter().copied().filter(|f| f.iter().all(|&i| (i as usize) < positions.len())).collect();
+    if faces.is_empty() {
+        return 0;
+    }
+    let corners = |f: [u32; 3]| -> [Point; 3] { f.map(|i| positions[i as usize].map(f64::from)) };
+    let boxes: Vec<(Point, Point)> = faces
+        .iter()
+        .map(|&f| {
+            let c = corners(f);
+            let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
+            let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
+            (lo, hi)
+        })
+        .collect();
+    let extent: f64 = boxes.iter().map(|(lo, hi)| (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)).sum();
+    let cell = (extent / boxes.len() as f64).max(f64::MIN_POSITIVE);
+    let key = |p: Point| p.map(|x| (x / cell).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    for (k, (lo, hi)) in boxes.iter().enumerate() {
+        let (a, b) = (key(*lo), key(*hi));
+        for x in a[0]..=b[0] {
+            for y in a[1]..=b[1] {
+                for z in a[2]..=b[2] {
+                    grid.entry([x, y, z]).or_default().push(k as u32);
+                }
+            }
+        }
+    }
+    let mut count = 0;
+    for (cell_key, members) in &grid {
+        for (n, &i) in members.iter().enumerate() {
+            for &j in &members[n + 1..] {
+                let ((lo_i, hi_i), (lo_j, hi_j)) = (boxes[i as usize], boxes[j as usize]);
+                if (0..3).any(|k| lo_i[k] > hi_j[k] || lo_j[k] > hi_i[k]) {
+                    continue;
+                }
+                if key([0, 1, 2].map(|k| lo_i[k].max(lo_j[k]))) != *cell_key {
+                    continue;
+                }
+                let (fi, fj) = (faces[i as usize], faces[j as usize]);
+                if fi.iter().any(|v| fj.contains(v)) {
+                    continue;
+                }
+                if triangles_intersect(corners(fi), corners(fj)) {
+                    count += 1;
+                }
+            }
+        }
+    }
+    count
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two separate squares, one poked through the other, and the count of crossing pairs found
+    /// by testing every pair directly.
+    #[test]
+    fn the_grid_finds_what_every_pair_finds() {
+        let mut positions: Vec<[f32; 3]> = Vec::new();
+        let mut faces: Vec<[u32; 3]> = Vec::new();
+        let mut square = |origin: [f32; 3], u: [f32; 3], v: [f32; 3], n: usize| {
+            let base = positions.len() as u32;
+            for j in 0..=n {
+                for i in 0..=n {
+                    let (a, b) = (i as f32 / n as f32, j as f32 / n as f32);
+                    positions.push([0, 1, 2].map(|k| origin[k] + a * u[k] + b * v[k]));
+                }
+            }
+            let at = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
+            for j in 0..n {
+                for i in 0..n {
+                    faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                    faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        };
+        square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 6);
+        square([0.33, 0.21, -0.4], [0.1, 0.3, 0.8], [0.35, -0.05, 0.1], 4);
+        let brute = (0..faces.len())
+            .flat_map(|i| (i + 1..faces.len()).map(move |j| (i, j)))
+            .filter(|&(i, j)| !faces[i].iter().any(|v| faces[j].contains(v)))
+            .filter(|&(i, j)| {
+                let c = |f: [u32; 3]| f.map(|k| positions[k as usize].map(f64::from));
+                triangles_intersect(c(faces[i]), c(faces[j]))
+            })
+            .count();
+        assert!(brute > 0);
+        assert_eq!(self_intersecting_pairs(&positions, &faces), brute);
+    }
+
+    #[test]
+    fn a_flat_sheet_does_not_intersect_itself() {
+        let positions: Vec<[f32; 3]> = (0..25).map(|k| [(k % 5) as f32, (k / 5) as f32, 0.0]).collect();
+        let faces: Vec<[u32; 3]> = (0..4u32)
+            .flat_map(|j| {
+                (0..4u32).flat_map(move |i| {
+                    let at = |i: u32, j: u32| j * 5 + i;
+                    [[at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]]
+                })
+            })
+            .collect();
+        assert_eq!(self_intersecting_pairs(&positions, &faces), 0);
+    }
+}

@@ -1,0 +1,45 @@
+//! Edge strain: how much each edge is longer or shorter than at rest, |l/l₀ − 1|.
+
+/// The largest and the mean edge strain of the mesh `faces` between `rest` and `current`
+/// positions. Edges with an index out of range or of zero rest length are left out; with no edge
+/// left both are 0.
+pub fn edge_strain(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]]) -> (f32, f32) {
+    let mut edges: Vec<[u32; 2]> = faces
+        .iter()
+        .flat_map(|f| [[f[0], f[1]], [f[1], f[2]], [f[2], f[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let length = |p: &[[f32; 3]], [a, b]: [u32; 2]| -> Option<f64> {
+        let (a, b) = (p.get(a as usize)?, p.get(b as usize)?);
+        Some((0..3).map(|k| (a[k] as f64 - b[k] as f64).powi(2)).sum::<f64>().sqrt())
+    };
+    let strains: Vec<f64> = edges
+        .iter()
+        .filter_map(|&e| {
+            let (l0, l) = (length(rest, e)?, length(current, e)?);
+            (l0 > 0.0).then(|| (l / l0 - 1.0).abs())
+        })
+        .collect();
+    if strains.is_empty() {
+        return (0.0, 0.0);
+    }
+    let max = strains.iter().copied().fold(0.0, f64::max);
+    (max as f32, (strains.iter().sum::<f64>() / strains.len() as f64) as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_triangle_stretched_along_x() {
+        let rest = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let stretched = [[0.0, 0.0, 0.0], [1.5, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let (max, mean) = edge_strain(&rest, &stretched, &[[0, 1, 2]]);
+        let hypotenuse = (1.5f32.hypot(1.0) / 2f32.sqrt()) - 1.0;
+        assert!((max - 0.5).abs() < 1e-6);
+        assert!((mean - (0.5 + hypotenuse) / 3.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,217 @@
+//! `mannequin cloth simulate` as a user runs it: a skirt tube around the default body's hips, its
+//! waist attached, on a short walk. The outputs are read back with readers of their own (PC2 by
+//! its header, the .npz by numpy's layout, the .glb by the Khronos validator and three.js), and
+//! bad garments are one-line errors before any work.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+mod common;
+use common::{mannequin, ok, one_line_error, s, scratch};
+use mannequin_body::BodyModel;
+use mannequin_mesh::ring_tube::RingLayout;
+use mannequin_mesh::{PointCache, TriMesh, write_obj};
+
+#[path = "../../../tools/node_checks.rs"]
+mod node_checks;
+use node_checks::{KHRONOS_VALIDATOR, THREE_JS};
+
+/// A 30 cm A-line skirt from the default body's hip line down, on 1.5 cm triangles. Its
+/// waistband hugs the body 1 cm out along each ray (attached, it then rides on the body like an
+/// elastic band); below, each ring is 2 cm out from the widest body point at or above it (so it
+/// never narrows), flaring 25 cm per metre, reached over the first 6 cm.
+fn skirt(dir: &Path) -> (PathBuf, usize) {
+    let body = BodyModel::default_body().template_mesh();
+    let (waist, length) = (-0.12, 0.3);
+    let near = |y0: f32, y1: f32| {
+        body.positions.iter().filter(move |p| p[1] <= y0 + 0.01 && p[1] >= y1 - 0.01 && p[0].abs() < 0.25)
+    };
+    let widest_above = |y: f32| {
+        near(waist, y).map(|p| (p[0] * p[0] + p[2] * p[2]).sqrt()).fold(0.0f32, f32::max)
+            + 0.02
+            + 0.25 * (waist - y)
+    };
+    // The farthest body point along the ray at angle `a` at the waist, within a 4 cm strip.
+    let band = |a: f32| {
+        let (sin, cos) = a.sin_cos();
+        near(waist + 0.01, waist - 0.01)
+            .filter(|p| (p[0] * sin - p[2] * cos).abs() < 0.02)
+            .map(|p| p[0] * cos + p[2] * sin)
+            .fold(0.0f32, f32::max)
+            + 0.01
+    };
+    let radius = widest_above(waist - length);
+    let segments = (std::f32::consts::TAU * radius / 0.015).round() as usize;
+    let rings = (length / 0.013).round() as usize;
+    let layout = RingLayout::uniform(segments, rings);
+    let positions = layout
+        .ring_of_vertices()
+        .enumerate()
+        .map(|(v, r)| {
+            let a = std::f32::consts::TAU * (v - layout.vertex(r, 0)) as f32 / segments as f32;
+            let y = waist - layout.rings[r] * length;
+            let t = ((waist - y) / 0.06).min(1.0);
+            let r = (1.0 - t) * band(a) + t * widest_above(y).max(band(a));
+            [r * a.cos(), y, r * a.sin()]
+        })
+        .collect();
+    let (faces, uv) = layout.tube();
+    let mut mesh = TriMesh::new(positions, faces);
+    mesh.uv = Some(uv);
+    let path = dir.join("skirt.obj");
+    write_obj(&path, &mesh).unwrap();
+    (path, segments)
+}
+
+#[test]
+fn a_skirt_walks_with_the_body() {
+    let dir = scratch("cloth-skirt");
+    let (garment, segments) = skirt(&dir);
+    let pins = dir.join("pins.json");
+    let waist: Vec<usize> = (0..segments).collect();
+    std::fs::write(&pins, serde_json::json!({ "attached": waist }).to_string()).unwrap();
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "--seconds", "0.5", "--fps", "30", "-o", s(&walk)]));
+    let out = dir.join("sim");
+    let run = |extra: &[&str]| {
+        let mut a =
+            vec!["cloth", "simulate", "--garment", s(&garment), "--pin", s(&pins), "--motion", s(&walk)];
+        a.extend_from_slice(&["--settle", "0.5", "--out", s(&out)]);
+        a.extend_from_slice(extra);
+        mannequin(&a)
+    };
+    ok(run(&[]));
+
+    let cache = PointCache::read(&out.join("garment.pc2")).unwrap();
+    let motion = mannequin_body::Motion::read(&walk).unwrap();
+    assert_eq!(cache.frames.len(), motion.num_frames());
+    let obj = mannequin_mesh::read_obj(&garment).unwrap();
+    assert_eq!(cache.frames[0].len(), obj.vertex_count());
+
+    let npz = mannequin_io::Npz::read(out.join("garment.npz")).unwrap();
+    let (shape, positions) = npz.f64_with_shape("positions", &[None, None, Some(3)]).unwrap();
+    assert_eq!(shape, vec![cache.frames.len(), obj.vertex_count(), 3]);
+    let last = cache.frames.last().unwrap();
+    let offset = (cache.frames.len() - 1) * obj.vertex_count() * 3;
+    assert!(last.iter().flatten().zip(&positions[offset..]).all(|(a, &b)| *a == b as f32), "npz = pc2");
+
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["frames"], cache.frames.len());
+    assert_eq!(metrics["per_frame"].as_array().unwrap().len(), cache.frames.len());
+    assert!(metrics["max_self_intersecting_pairs"].as_u64().is_some(), "{metrics}");
+    assert_eq!(metrics["max_vertices_inside_body"], 0, "{metrics}");
+    // Cotton keeps its length on average; single edges in the folds of the flare move more
+    // (0.50 at most here, without self-collision the folds pass through each other).
+    assert!(metrics["mean_edge_strain"].as_f64().unwrap() < 0.05, "{metrics}");
+    assert!(metrics["max_edge_strain"].as_f64().unwrap() < 1.0, "{metrics}");
+
+    // The attached waist stays on the walking body: within 2 cm of where its rest binding puts it,
+    // which moves with the hips (the walk's root moves several cm over the clip).
+    let first_waist: Vec<[f32; 3]> = cache.frames[0][..segments].to_vec();
+    let moved =
+        last[..segments].iter().zip(&first_waist).map(|(a, b)| (a[2] - b[2]).abs()).fold(0.0, f32::max);
+    assert!(moved > 0.01, "the waist follows the walk forward ({moved} m)");
+
+    let glb = out.join("scene.glb");
+    if let Some(report) = KHRONOS_VALIDATOR.run(&glb) {
+        assert!(report.contains(" 0 errors, 0 warnings"), "{report}");
+    }
+    if let Some(report) = THREE_JS.run(&glb) {
+        assert!(report.contains("1 skinned mesh(es), 1 animation(s)"), "{report}");
+        // The UV seam's column is written twice: one vertex more per ring.
+        let seam = obj.uv.as_ref().unwrap().coords.iter().filter(|t| t[0] == 0.0).count();
+        let written = obj.vertex_count() + seam;
+        let targets = format!("morph mesh 'garment': {written} vertices, {} targets", cache.frames.len());
+        assert!(report.contains(&targets), "{report}");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn bad_garments_are_one_line_errors() {
+    let dir = scratch("cloth-bad");
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "--seconds", "0.2", "-o", s(&walk)]));
+    let simulate = |garment: &Path, pins: Option<&Path>| {
+        let mut a = vec!["cloth", "simulate", "--garment", s(garment), "--motion", s(&walk)];
+        if let Some(p) = pins {
+            a.extend_from_slice(&["--pin", s(p)]);
+        }
+        let out = dir.join("out");
+        a.extend_from_slice(&["--out", s(&out)]);
+        mannequin(&a)
+    };
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    // Three triangles on one edge, around the hips.
+    let fan =
+        "v 0 0 0.2\nv 0.1 0 0.2\nv 0 0.1 0.2\nv 0.1 0.1 0.2\nv 0.05 0.05 0.25\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
+    let nonmanifold = write("fan.obj", fan);
+    one_line_error(&simulate(&nonmanifold, None), &["fan.obj", "edge", "3"]);
+    let degenerate = write("flat.obj", "v 0 0 0.2\nv 0.1 0 0.2\nv 0.2 0 0.2\nf 1 2 3\n");
+    one_line_error(&simulate(&degenerate, None), &["flat.obj", "faces[0]", "degenerate"]);
+    let far = write("far.obj", "v 5 0 0\nv 5.1 0 0\nv 5 0.1 0\nf 1 2 3\n");
+    one_line_error(&simulate(&far, None), &["far.obj", "far from the body"]);
+    let square = write("square.obj", "v 0 0 0.2\nv 0.1 0 0.2\nv 0 0.1 0.2\nf 1 2 3\n");
+    let pins = write("pins.json", r#"{"fixed": [0, 7]}"#);
+    one_line_error(&simulate(&square, Some(&pins)), &["pins.json", "fixed", "vertex 7", "3 vertices"]);
+    let nan = write("nan.obj", "v 0 0 0.2\nv nan 0 0.2\nv 0 0.1 0.2\nf 1 2 3\n");
+    one_line_error(&simulate(&nan, None), &["nan.obj"]);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A run killed after a checkpoint and run again with the same command ends with the same
+/// frames, bit for bit, as a run never stopped; a changed option is refused naming it.
+#[test]
+fn a_killed_run_resumes_to_the_same_frames() {
+    let dir = scratch("cloth-resume");
+    let (garment, segments) = skirt(&dir);
+    let pins = dir.join("pins.json");
+    std::fs::write(&pins, serde_json::json!({ "attached": (0..segments).collect::<Vec<_>>() }).to_string())
+        .unwrap();
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "--seconds", "0.4", "--fps", "30", "-o", s(&walk)]));
+    let args = |out: &Path| -> Vec<String> {
+        let a = ["cloth", "simulate", "--garment", s(&garment), "--pin", s(&pins), "--motion", s(&walk)];
+        let b = ["--settle", "0.3", "--checkpoint-every", "4", "--out", s(out)];
+        a.iter().chain(&b).map(|x| x.to_string()).collect()
+    };
+    let whole = dir.join("whole");
+    ok(Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args(&whole)).output().unwrap());
+
+    let resumed = dir.join("resumed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mannequin"))
+        .args(args(&resumed))
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let checkpoint = resumed.join("checkpoint.npz");
+    let start = std::time::Instant::now();
+    while !checkpoint.exists() && start.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(checkpoint.exists(), "no checkpoint within 2 minutes");
+    assert!(!resumed.join("garment.pc2").exists(), "killed before the end");
+
+    let mut changed = args(&resumed);
+    changed.extend(["--material".into(), "denim".into()]);
+    let o = Command::new(env!("CARGO_BIN_EXE_mannequin")).args(&changed).output().unwrap();
+    one_line_error(&o, &["checkpoint.npz", "material was \"cotton\", now \"denim\"", "--restart"]);
+
+    let o = ok(Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args(&resumed)).output().unwrap());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("resuming"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(!checkpoint.exists(), "a finished run leaves no checkpoint");
+    let read = |d: &Path| std::fs::read(d.join("garment.pc2")).unwrap();
+    assert!(read(&whole) == read(&resumed), "resumed frames differ from the uninterrupted run's");
+    std::fs::remove_dir_all(dir).ok();
+}
