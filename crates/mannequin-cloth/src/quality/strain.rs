@@ -4,13 +4,7 @@
 /// positions. Edges with an index out of range or of zero rest length are left out; with no edge
 /// left both are 0.
 pub fn edge_strain(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]]) -> (f32, f32) {
-    let mut edges: Vec<[u32; 2]> = faces
-        .iter()
-        .flat_map(|f| [[f[0], f[1]], [f[1], f[2]], [f[2], f[0]]])
-        .map(|[a, b]| [a.min(b), a.max(b)])
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
+    let edges = mannequin_mesh::adjacency::edges(faces);
     let length = |p: &[[f32; 3]], [a, b]: [u32; 2]| -> Option<f64> {
         let (a, b) = (p.get(a as usize)?, p.get(b as usize)?);
         Some((0..3).map(|k| (a[k] as f64 - b[k] as f64).powi(2)).sum::<f64>().sqrt())
