@@ -48,9 +48,9 @@ pub struct SimulateArgs {
     /// Seconds before the motion: half at rest, half blending into its first frame.
     #[arg(long, default_value_t = 1.0)]
     settle: f32,
-    /// Cloth–cloth contacts (vertex–triangle, Eq. 3.22). Experimental: they still tangle and
-    /// blow up where cloth piles onto itself, so they are off unless asked for, and
-    /// metrics.json counts the self-intersecting pairs either way.
+    /// Cloth–cloth contacts (vertex–triangle, Eq. 3.22). Experimental: cloth piling onto itself
+    /// still tangles in places and they cost about 4× the time, so they are off unless asked
+    /// for; metrics.json counts the self-intersecting pairs either way.
     #[arg(long)]
     self_collision: bool,
     /// Output folder.
