@@ -15,12 +15,15 @@
 //! `--half-resolution-share F` trains the first share F of the iterations at half resolution
 //! (default 0.5; 0 trains all at full resolution, the baseline of that schedule).
 //!
+//! `--device gpu` trains on the wgpu device (Vulkan; `mannequin_splat::gpu_device`) instead of
+//! Flex, and judges the time against the GPU target (15 s) instead of the CPU one (300 s).
+//!
 //! `--pose-noise DEG` trains on poses perturbed as a monocular pose estimator would leave them:
 //! each axis-angle component of every joint below the root gets seeded normal noise of DEG
 //! degrees (default 0). The root is left exact, as a camera-relative fit pins it best. Evaluation
 //! keeps the exact test poses.
 //!
-//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE] [--half-resolution-share F] [--pose-noise DEG]`
+//! `cargo bench -p mannequin-avatar --bench train -- [--iters N] [--seed S] [--subjects N] [--ablations] [--antialiased] [--dilation D] [--skirt MODE] [--half-resolution-share F] [--pose-noise DEG] [--device cpu|gpu]`
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -73,7 +76,7 @@ fn run(
     breakdown: bool,
 ) -> (Scores, f64) {
     let Subject { canonical, views, data, dir } = *subject;
-    let avatar = Avatar::new(config, canonical.clone(), &Device::flex().autodiff()).expect("avatar");
+    let avatar = Avatar::new(config, canonical.clone(), &device().autodiff()).expect("avatar");
     let gaussians = avatar.num_gaussians();
     let iters = options.iterations;
     let mut trainer = Trainer::new(avatar, views.to_vec(), options).expect("trainer");
@@ -81,6 +84,7 @@ fn run(
     let mut sum = Timings::default();
     let timed = iters.saturating_sub(TIMED).max(3)..iters;
     for i in 0..iters {
+        trainer.profile = timed.contains(&i);
         let t = trainer.step().expect("step").timings;
         if timed.contains(&i) {
             sum.skinning += t.skinning;
@@ -91,6 +95,7 @@ fn run(
             sum.optimiser += t.optimiser;
         }
     }
+    // Includes the timed iterations, whose waits at each phase cost a GPU a little.
     let per_iter = start.elapsed().as_secs_f64() / iters as f64;
     if breakdown {
         let n = timed.len().max(1) as u32;
@@ -109,6 +114,20 @@ fn run(
     let options = EvalOptions { background: [1.0; 3], lpips: None, samples: 100_000, seed: 0 };
     let scores = evaluate_avatar(&model_dir, data, &options, &|_, _| {}, &|| {}).expect("evaluate");
     (scores, per_iter)
+}
+
+/// Whether `--device gpu` was asked for.
+fn on_gpu() -> bool {
+    match arg("--device", String::from("cpu")).as_str() {
+        "cpu" => false,
+        "gpu" => true,
+        other => panic!("--device takes cpu or gpu, not {other}"),
+    }
+}
+
+/// The training device: Flex, or the wgpu device with `--device gpu`.
+fn device() -> Device {
+    if on_gpu() { mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}")) } else { Device::flex() }
 }
 
 /// Switches one component off.
@@ -218,8 +237,13 @@ fn targets(s: &Scores, full: &AvatarConfig, projected: f64) {
     let angle = g.normal_angle_deg.unwrap_or(f64::NAN);
     row("Chamfer to GT clothed mesh (cm)", chamfer, "<= 0.5", chamfer <= 0.5);
     row("foreground normal angle (deg)", angle, "<= 10", angle <= 10.0);
-    row("2,000 iterations, this CPU (s)", projected, "<= 300", projected <= 300.0);
-    println!("  (ratio target / projected time: {:.2})", 300.0 / projected);
+    let (what, limit) = if on_gpu() {
+        ("2,000 iterations, this GPU (s)", 15.0)
+    } else {
+        ("2,000 iterations, this CPU (s)", 300.0)
+    };
+    row(what, projected, &format!("<= {limit}"), projected <= limit);
+    println!("  (ratio target / projected time: {:.2})", limit / projected);
 }
 
 /// Tavatar Table 4 averaged over subjects (the per-subject rows are printed as they finish); the ordering is judged on the means,

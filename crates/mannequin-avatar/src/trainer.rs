@@ -106,6 +106,9 @@ pub struct Trainer {
     laplacian_scale: f64,
     /// Each parameter's learning rate at iteration 0.
     base_lr: Vec<f64>,
+    /// Wait for the device at each phase boundary, so that [`Timings`] charges each phase its
+    /// own work on a GPU, whose launches return before the work is done (costs throughput).
+    pub profile: bool,
 }
 
 /// Mean edge length of the canonical mesh (each edge counted once per face side).
@@ -158,7 +161,18 @@ impl Trainer {
         } else {
             Vec::new()
         };
-        Ok(Self { avatar, options, iteration: 0, adam, views, halved, topology, laplacian_scale, base_lr })
+        Ok(Self {
+            avatar,
+            options,
+            iteration: 0,
+            adam,
+            views,
+            halved,
+            topology,
+            laplacian_scale,
+            base_lr,
+            profile: false,
+        })
     }
 
     pub fn num_views(&self) -> usize {
@@ -216,9 +230,20 @@ impl Trainer {
         let (grads, value, psnr, mut t) = self.loss_and_gradients()?;
         let clock = Instant::now();
         self.adam.update(&mut self.avatar.params, &grads);
-        t.optimiser = clock.elapsed();
+        t.optimiser = self.lap(clock)?;
         self.iteration += 1;
         Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
+    }
+
+    /// Time since `clock`, after the device has finished its work when profiling.
+    fn lap(&self, clock: Instant) -> Result<Duration, AvatarError> {
+        if self.profile {
+            self.avatar
+                .device()
+                .sync()
+                .map_err(|e| AvatarError::Invalid(format!("the device failed: {e:?}")))?;
+        }
+        Ok(clock.elapsed())
     }
 
     /// This iteration's gradients, loss and PSNR. Every forward tensor is dropped on return, so
@@ -234,20 +259,21 @@ impl Trainer {
         let o = &self.options;
         let mut t = Timings::default();
 
+        self.lap(Instant::now())?;
         let clock = Instant::now();
         let offsets = self.avatar.offsets()?;
         let personalised = self.avatar.personalised(offsets.clone());
         let vertices = self.avatar.skin(personalised.clone(), &view.pose, view.transl)?;
-        t.skinning = clock.elapsed();
+        t.skinning = self.lap(clock)?;
         let clock = Instant::now();
         let gaussians = self.avatar.bind(&vertices);
-        t.derivation = clock.elapsed();
+        t.derivation = self.lap(clock)?;
         let clock = Instant::now();
         let posed = crate::avatar::Posed { personalised: personalised.clone(), vertices, gaussians };
         // Only the crop is rendered: the losses look nowhere else.
         let crop = &view.crop;
         let r = self.avatar.render(&posed, &view.crop_camera())?;
-        t.render = clock.elapsed();
+        t.render = self.lap(clock)?;
 
         let clock = Instant::now();
         let target = image_tensor(&view.targets, view.target_channels(), crop, &device);
@@ -272,7 +298,7 @@ impl Trainer {
             loss = loss + self.topology.equilateral(personalised)? * o.lambda_equilateral;
         }
         let value = loss.clone().into_scalar::<f64>();
-        t.losses = clock.elapsed();
+        t.losses = self.lap(clock)?;
         if !value.is_finite() {
             return Err(AvatarError::NonFiniteLoss {
                 iteration: self.iteration + 1,
@@ -284,7 +310,7 @@ impl Trainer {
 
         let clock = Instant::now();
         let grads = loss.backward();
-        t.backward = clock.elapsed();
+        t.backward = self.lap(clock)?;
         Ok((grads, value, psnr, t))
     }
 

@@ -3,6 +3,11 @@
 //!
 //! `cargo bench -p mannequin-splat --bench splat` (add `-- --quick` for fewer repetitions,
 //! `-- --ours-only` to skip the baseline when profiling).
+//!
+//! `-- --device gpu` times the Burn op (`splat_render`, forward and forward+backward through
+//! autodiff) on the wgpu device against the same op on Flex, and with `--save-scenes DIR` writes
+//! each scene, camera and image gradient as `DIR/scene_N.npz` for `tools/bench/gsplat_speed.py`,
+//! which times gsplat's CUDA rasterizer on them in the same job.
 //! Scenes: a human-sized shell (1.7 m tall, 2.5 m from the camera) with 40k and 200k Gaussians.
 
 use std::time::Instant;
@@ -264,6 +269,9 @@ fn best_ms(reps: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn main() {
+    if std::env::args().any(|a| a == "--device") {
+        return gpu::main();
+    }
     let quick = std::env::args().any(|a| a == "--quick");
     // For profiling: time only this crate's renderer.
     let ours_only = std::env::args().any(|a| a == "--ours-only");
@@ -342,5 +350,119 @@ fn main() {
             "         {contributions} Gaussian-pixel contributions per frame, alpha coverage {:.1}%",
             100.0 * out.alpha.iter().filter(|&&a| a > 0.5).count() as f64 / (w * h) as f64
         );
+    }
+}
+
+/// The Burn op on the wgpu device against the same op on Flex.
+mod gpu {
+    use super::*;
+    use burn::tensor::{Device, Tensor, TensorData};
+    use mannequin_io::{NpyArray, NpzWriter};
+    use mannequin_splat::{ColorTensor, RotationTensor, splat_render};
+
+    /// The scene's tensors on one device, made once so uploads stay out of the timings.
+    struct Inputs {
+        means: Tensor<2>,
+        quats: Tensor<2>,
+        scales: Tensor<2>,
+        opacities: Tensor<1>,
+        sh: Tensor<3>,
+        d_image: Tensor<3>,
+    }
+
+    impl Inputs {
+        fn new(scene: &Scene, d_image: &[f32], w: usize, h: usize, device: &Device) -> Self {
+            let n = scene.opacities.len();
+            let k = (SH_DEGREE + 1) * (SH_DEGREE + 1);
+            let t2 =
+                |v: &[f32], c: usize| Tensor::<2>::from_data(TensorData::new(v.to_vec(), [n, c]), device);
+            Inputs {
+                means: t2(&scene.means, 3),
+                quats: t2(&scene.quats, 4),
+                scales: t2(&scene.scales, 3),
+                opacities: Tensor::from_data(TensorData::new(scene.opacities.clone(), [n]), device),
+                sh: Tensor::from_data(TensorData::new(scene.sh.clone(), [n, k, 3]), device),
+                d_image: Tensor::from_data(TensorData::new(d_image.to_vec(), [3, h, w]), device),
+            }
+        }
+
+        /// One render; with `backward`, also the gradients of every input of L = ⟨image, dL/dimage⟩.
+        fn run(&self, camera: &Camera, opts: &RenderOptions, backward: bool, device: &Device) {
+            let leaf = |t: &Tensor<2>| if backward { t.clone().require_grad() } else { t.clone() };
+            let means = leaf(&self.means);
+            let out = splat_render(
+                means.clone(),
+                RotationTensor::Quaternions(leaf(&self.quats)),
+                leaf(&self.scales),
+                self.opacities.clone(),
+                ColorTensor::Sh { degree: SH_DEGREE, coeffs: self.sh.clone() },
+                camera,
+                opts,
+            )
+            .expect("render");
+            if backward {
+                let grads = (out.image * self.d_image.clone()).sum().backward();
+                std::hint::black_box(means.grad(&grads));
+            } else {
+                std::hint::black_box(out.image);
+            }
+            device.sync().expect("sync");
+        }
+    }
+
+    fn save(dir: &std::path::Path, n: usize, scene: &Scene, camera: &Camera, d_image: &[f32]) {
+        let (w, h) = (camera.width, camera.height);
+        let k = (SH_DEGREE + 1) * (SH_DEGREE + 1);
+        let flat = |m: &[[f64; 4]; 4]| m.iter().flatten().map(|&v| v as f32).collect();
+        let mut npz = NpzWriter::new();
+        npz.add("means", NpyArray::f32(vec![n, 3], scene.means.clone()))
+            .add("quats", NpyArray::f32(vec![n, 4], scene.quats.clone()))
+            .add("scales", NpyArray::f32(vec![n, 3], scene.scales.clone()))
+            .add("opacities", NpyArray::f32(vec![n], scene.opacities.clone()))
+            .add("sh", NpyArray::f32(vec![n, k, 3], scene.sh.clone()))
+            .add("viewmat", NpyArray::f32(vec![4, 4], flat(&camera.extrinsic)))
+            .add(
+                "K",
+                NpyArray::f32(vec![3, 3], camera.intrinsic.iter().flatten().map(|&v| v as f32).collect()),
+            )
+            .add("d_image", NpyArray::f32(vec![3, h, w], d_image.to_vec()));
+        std::fs::create_dir_all(dir).expect("scene folder");
+        npz.write(dir.join(format!("scene_{n}.npz"))).expect("write scene");
+    }
+
+    pub fn main() {
+        let args: Vec<String> = std::env::args().collect();
+        let value = |name: &str| args.iter().position(|a| a == name).and_then(|i| args.get(i + 1)).cloned();
+        assert_eq!(
+            value("--device").as_deref(),
+            Some("gpu"),
+            "--device takes gpu here (the CPU bench is the default)"
+        );
+        let save_dir = value("--save-scenes").map(std::path::PathBuf::from);
+        let reps = if args.iter().any(|a| a == "--quick") { 5 } else { 21 };
+        let gpu = mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}")).autodiff();
+        let flex = Device::flex().autodiff();
+        let (w, h) = (540, 540);
+        let camera = Camera::look_at([0.0, 0.9, 2.5], [0.0, 0.85, 0.0], [0.0, 1.0, 0.0], 0.72, w, h);
+        let opts = RenderOptions { background: vec![1.0, 1.0, 1.0], ..RenderOptions::default() };
+        println!(
+            "splat_render through Burn autodiff, {w}×{h}, SH degree {SH_DEGREE}; best of {reps} after a warm-up"
+        );
+        println!("{:>8} {:>12} {:>12} {:>12} {:>10}", "N", "device", "forward ms", "fwd+bwd ms", "speed-up");
+        for n in [40_000, 200_000] {
+            let scene = human_shell(n, 7);
+            let d_image: Vec<f32> = (0..3 * w * h).map(|i| ((i % 7) as f32 - 3.0) * 0.01).collect();
+            if let Some(dir) = &save_dir {
+                save(dir, n, &scene, &camera, &d_image);
+            }
+            let mut base = None;
+            for (name, device) in [("flex (CPU)", &flex), ("wgpu", &gpu)] {
+                let inputs = Inputs::new(&scene, &d_image, w, h, device);
+                let fwd = best_ms(reps, || inputs.run(&camera, &opts, false, device));
+                let both = best_ms(reps, || inputs.run(&camera, &opts, true, device));
+                let speedup = base.get_or_insert(both).to_owned() / both;
+                println!("{n:>8} {name:>12} {fwd:>12.2} {both:>12.2} {speedup:>9.1}×");
+            }
+        }
     }
 }

@@ -4,6 +4,7 @@
 mod animate;
 mod body;
 mod cloth;
+mod compute;
 mod demo;
 mod eval;
 mod export;

@@ -14,6 +14,7 @@ use mannequin_body::BodyModel;
 use mannequin_data::{Dataset, Fingerprint};
 use mannequin_io::Npz;
 
+use crate::compute::Compute;
 use crate::progress::{JobTimer, bar};
 
 #[derive(ClapArgs, Clone)]
@@ -64,6 +65,9 @@ pub struct Args {
     /// mid-thigh) or off.
     #[arg(long, value_enum, default_value_t = SkirtMode::Auto)]
     pub skirt: SkirtMode,
+    /// Where training runs: cpu (Flex) or gpu (wgpu on Vulkan).
+    #[arg(long, value_enum, default_value_t = Compute::Cpu)]
+    pub device: Compute,
     /// Start over even if the model folder holds a checkpoint.
     #[arg(long)]
     pub restart: bool,
@@ -154,7 +158,7 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
         tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
     }
     record.avatar.skirt_layer = skirt.is_some();
-    let device = burn::tensor::Device::flex().autodiff();
+    let device = args.device.device()?.autodiff();
     let avatar = Avatar::new(record.avatar.clone(), canonical, &device)?;
     let mut trainer = Trainer::new(avatar, views, record.options.clone())?;
     if resume {
@@ -199,7 +203,7 @@ pub fn train(mut trainer: Trainer, record: &TrainingRun, args: &Args) -> Result<
             if progress.is_hidden() {
                 // No terminal: keep a log line per checkpoint instead of the bar.
                 tracing::info!(
-                    "iteration {}/{}: loss {:.4}, running PSNR {p:.2} dB",
+                    "iteration {}/{}: loss {:.6}, running PSNR {p:.2} dB",
                     stats.iteration,
                     args.iters,
                     stats.loss
