@@ -57,7 +57,7 @@ impl Simulator {
             attachments,
             contacts: settings
                 .self_collision
-                .then(|| SelfContacts::new(settings.thickness, &cloth.edges(), n)),
+                .then(|| SelfContacts::new(settings.thickness, cloth.edges(), n)),
             positions: cloth.rest.clone(),
             velocities: vec![[0.0; 3]; n],
             previous: cloth.rest.clone(),
@@ -137,7 +137,7 @@ impl Simulator {
             self.times.bending += t.elapsed();
             if let Some(contacts) = &mut self.contacts {
                 let t = Instant::now();
-                contacts.project(&mut self.positions, w, &self.cloth.faces);
+                contacts.project(&mut self.positions, &self.previous, w, &self.cloth.faces);
                 self.times.self_contacts += t.elapsed();
             }
             if let Some(body) = &self.body {

@@ -1,0 +1,219 @@
+//! Edge–edge contacts: two edges whose common perpendicular meets both inside are kept their gap
+//! apart along the common normal m = e₁ × e₂. Vertex–triangle contacts miss edges that pass
+//! through each other while every vertex stays beside the other triangles, which is how cloth
+//! crumpled at the scale of its triangles tangles.
+//!
+//! As for vertex–triangle contacts, the side is the current one unless the edges passed through
+//! each other in this substep: the four particles became coplanar at a moment when the edges
+//! met. (They also become coplanar, far apart, whenever the edges turn through parallel, which
+//! in a flat sheet happens all the time: that flips the common normal but crosses nothing.)
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::crossing::{between, coplanar_time, volume};
+use super::{Neighbours, Reach, push_weights};
+use crate::box_hash::{Aabb, BoxHash};
+
+/// Closest points this close to an edge's end (as a fraction of it) count as at the end.
+const END_TOLERANCE: f32 = 1e-3;
+/// Edges closer to parallel than this (|ê₁ × ê₂|, about 12°) have no well-conditioned common
+/// normal: it swings wildly as they turn, and the side with it. The vertex–triangle contacts of
+/// their ends hold them.
+const PARALLEL: f32 = 0.2;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Pair {
+    /// Indices into the cloth's edge list, first < second.
+    first: u32,
+    second: u32,
+    gap: f32,
+}
+
+#[derive(Debug, Clone, Default)]
+pub(crate) struct EdgeEdge {
+    pairs: Vec<Pair>,
+    boxes: Vec<Aabb>,
+    hash: BoxHash,
+}
+
+/// The closest points of segments p₁p₂ and q₁q₂, as fractions (s, t) along each (Ericson,
+/// *Real-Time Collision Detection*, §5.1.9).
+fn closest_fractions(p1: Vec3, p2: Vec3, q1: Vec3, q2: Vec3) -> (f32, f32) {
+    let (d1, d2, r) = (p2 - p1, q2 - q1, p1 - q1);
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    if a <= f32::MIN_POSITIVE || e <= f32::MIN_POSITIVE {
+        return (0.0, 0.0);
+    }
+    let (b, c) = (d1.dot(d2), d1.dot(r));
+    let denominator = a * e - b * b;
+    let s = if denominator > 0.0 { ((b * f - c * e) / denominator).clamp(0.0, 1.0) } else { 0.0 };
+    let t = (b * s + f) / e;
+    if t < 0.0 {
+        (((-c) / a).clamp(0.0, 1.0), 0.0)
+    } else if t > 1.0 {
+        (((b - c) / a).clamp(0.0, 1.0), 1.0)
+    } else {
+        (s, t)
+    }
+}
+
+/// Where the lines through p₁p₂ and q₁q₂ pass each other: their signed distance along the unit
+/// common normal m̂ = (p₂ − p₁) × (q₂ − q₁) / |…|, the normal, and the fractions (s, t) along each
+/// edge of the points where the common perpendicular meets them. `None` for parallel edges.
+fn lines_passing(p1: Vec3, p2: Vec3, q1: Vec3, q2: Vec3) -> Option<(f32, Vec3, f32, f32)> {
+    let (d1, d2, r) = (p2 - p1, q2 - q1, p1 - q1);
+    let m = d1.cross(d2);
+    let square = m.length_squared();
+    if square.sqrt() <= PARALLEL * d1.length() * d2.length() {
+        return None;
+    }
+    let (a, b, c, e, f) = (d1.dot(d1), d1.dot(d2), d1.dot(r), d2.dot(d2), d2.dot(r));
+    let (s, t) = ((b * f - c * e) / square, (a * f - b * c) / square);
+    let normal = m / square.sqrt();
+    Some((r.dot(normal), normal, s, t))
+}
+
+/// A fraction strictly inside its edge.
+fn inside(x: f32) -> bool {
+    x > END_TOLERANCE && x < 1.0 - END_TOLERANCE
+}
+
+/// The distance between the closest points of segments p₁p₂ and q₁q₂.
+fn segment_distance(p1: Vec3, p2: Vec3, q1: Vec3, q2: Vec3) -> f32 {
+    let (s, t) = closest_fractions(p1, p2, q1, q2);
+    (p1 + s * (p2 - p1)).distance(q1 + t * (q2 - q1))
+}
+
+impl EdgeEdge {
+    /// Every pair of edges without a common vertex within reach at `reference`. Each edge's box
+    /// is inflated by the reach and half the longest edge, so it holds the midpoint of every edge
+    /// within reach, which is what each edge queries with.
+    pub fn rebuild(&mut self, reference: &[[f32; 3]], edges: &[[u32; 2]], reach: Reach, near: &Neighbours) {
+        let at = |i: u32| Vec3::from(reference[i as usize]);
+        let longest = edges.iter().map(|&[a, b]| at(a).distance(at(b))).fold(0.0, f32::max);
+        self.boxes.clear();
+        self.boxes
+            .extend(edges.iter().map(|e| Aabb::around(&e.map(at)).inflated(reach.distance + 0.5 * longest)));
+        let extents: f32 = self.boxes.iter().map(|b| b.extent().max_element()).sum();
+        self.hash.build(&self.boxes, extents / self.boxes.len().max(1) as f32);
+        let (hash, boxes) = (&self.hash, &self.boxes);
+        let found: Vec<Vec<Pair>> = (0..edges.len() as u32)
+            .into_par_iter()
+            .map(|first| {
+                let e1 = edges[first as usize];
+                let (p1, p2) = (at(e1[0]), at(e1[1]));
+                let middle = 0.5 * (p1 + p2);
+                let mut candidates: Vec<u32> = hash
+                    .query(middle)
+                    .iter()
+                    .copied()
+                    .filter(|&second| {
+                        let e2 = edges[second as usize];
+                        second > first
+                            && boxes[second as usize].contains(middle)
+                            && !e2.iter().any(|v| e1.contains(v))
+                    })
+                    .collect();
+                candidates.sort_unstable();
+                candidates.dedup();
+                candidates
+                    .into_iter()
+                    .filter_map(|second| {
+                        let e2 = edges[second as usize];
+                        let (q1, q2) = (at(e2[0]), at(e2[1]));
+                        if segment_distance(p1, p2, q1, q2) > reach.distance {
+                            return None;
+                        }
+                        Some(Pair { first, second, gap: reach.gap(near.touch(&e1, &e2)) })
+                    })
+                    .collect()
+            })
+            .collect();
+        self.pairs.clear();
+        self.pairs.extend(found.into_iter().flatten());
+    }
+
+    /// One Gauss–Seidel pass over the pairs, in their (first, second) order; `previous` holds the
+    /// positions at the start of the substep.
+    pub fn project(
+        &self,
+        positions: &mut [[f32; 3]],
+        previous: &[[f32; 3]],
+        inverse_mass: &[f32],
+        edges: &[[u32; 2]],
+        most: f32,
+    ) {
+        for pair in &self.pairs {
+            let ([a, b], [c, d]) = (edges[pair.first as usize], edges[pair.second as usize]);
+            let particles = [a, b, c, d];
+            let now = particles.map(|i| Vec3::from(positions[i as usize]));
+            let [p1, p2, q1, q2] = now;
+            let Some((separation, normal, s, t)) = lines_passing(p1, p2, q1, q2) else {
+                continue;
+            };
+            // The volume of (q₁, p₁, p₂, q₂) is m·(p₁ − q₁): the separation times |m|.
+            let order = |x: [Vec3; 4]| [x[2], x[0], x[1], x[3]];
+            let start = particles.map(|i| Vec3::from(previous[i as usize]));
+            let (before, after) = (volume(order(start)), volume(order(now)));
+            let crossed = before * after < 0.0 && {
+                let [p1, p2, q1, q2] = between(start, now, coplanar_time(order(start), order(now)));
+                lines_passing(p1, p2, q1, q2).is_some_and(|(_, _, s, t)| {
+                    [s, t].iter().all(|x| (-END_TOLERANCE..=1.0 + END_TOLERANCE).contains(x))
+                })
+            };
+            let side = if crossed { -separation.signum() } else { separation.signum() };
+            if !(crossed || inside(s) && inside(t)) {
+                continue;
+            }
+            let violation = (side * separation - pair.gap).max(-most);
+            if violation >= 0.0 {
+                continue;
+            }
+            let (s, t) = (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
+            let share = [1.0 - s, s, t - 1.0, -t];
+            let Some(moves) = push_weights(particles.map(|i| inverse_mass[i as usize]), share) else {
+                continue;
+            };
+            let push = -violation * side * normal;
+            for k in 0..4 {
+                let p = Vec3::from(positions[particles[k] as usize]);
+                positions[particles[k] as usize] = (p + moves[k] * push).to_array();
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closest_points_of_crossing_and_offset_segments() {
+        let (s, t) =
+            closest_fractions(Vec3::ZERO, Vec3::X, Vec3::new(0.25, -1.0, 1.0), Vec3::new(0.25, 1.0, 1.0));
+        assert!((s - 0.25).abs() < 1e-6 && (t - 0.5).abs() < 1e-6, "{s} {t}");
+        let (s, t) =
+            closest_fractions(Vec3::ZERO, Vec3::X, Vec3::new(2.0, -1.0, 0.5), Vec3::new(2.0, 1.0, 0.5));
+        assert!((s - 1.0).abs() < 1e-6 && (t - 0.5).abs() < 1e-6, "{s} {t}");
+    }
+
+    #[test]
+    fn the_separation_changes_sign_when_edges_pass_through_each_other() {
+        let (q1, q2) = (Vec3::new(0.3, -1.0, 0.0), Vec3::new(0.3, 1.0, 0.0));
+        let lift = |z: f32| lines_passing(Vec3::ZERO, Vec3::X, q1 + z * Vec3::Z, q2 + z * Vec3::Z).unwrap();
+        let (above, below) = (lift(0.1), lift(-0.1));
+        assert!((above.0 + 0.1).abs() < 1e-6 && (below.0 - 0.1).abs() < 1e-6, "{above:?} {below:?}");
+        assert!((above.2 - 0.3).abs() < 1e-6 && (above.3 - 0.5).abs() < 1e-6, "{above:?}");
+    }
+
+    /// Nearly parallel edges side by side in one plane: their lines pass far beyond the edges,
+    /// so the pair is no contact, however close the edges.
+    #[test]
+    fn side_by_side_edges_are_not_crossing() {
+        // Nearly parallel: no common normal at all, or one whose feet miss the edges' insides.
+        let passing =
+            lines_passing(Vec3::ZERO, Vec3::X, Vec3::new(0.0, 0.01, 0.0), Vec3::new(1.0, 0.012, 0.0));
+        assert!(passing.is_none_or(|(_, _, s, t)| !(inside(s) && inside(t))), "{passing:?}");
+    }
+}
