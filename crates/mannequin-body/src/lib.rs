@@ -10,6 +10,7 @@ pub mod model;
 pub mod motion;
 pub mod named_pose;
 pub mod rodrigues;
+pub mod settling;
 pub mod skinned_export;
 pub mod smpl_joint;
 pub mod smpl_npz;
@@ -22,5 +23,6 @@ pub use lbs_tensor::{BodyTensors, PosedTensors, Rig, forward_tensors, rodrigues_
 pub use model::{BodyModel, BodyModelParts, ModelFamily};
 pub use motion::Motion;
 pub use named_pose::{POSE_NAMES, named_pose};
+pub use settling::Settling;
 pub use skinned_export::{skeletal_animation, skinned_body};
 pub use smpl_npz::{load_model, parse_model};

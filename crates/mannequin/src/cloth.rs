@@ -8,7 +8,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use mannequin_body::{BodyModel, Motion, pose_frames, shape_body, skeletal_animation, skinned_body};
+use mannequin_body::{
+    BodyModel, Motion, Settling, pose_frames, shape_body, skeletal_animation, skinned_body,
+};
 use mannequin_cloth::{
     Attachment, Body, Cloth, ClothState, MATERIAL_NAMES, Material, Settings, Simulator, quality,
 };
@@ -129,44 +131,6 @@ struct FrameMetrics {
     simulation_ms: f64,
 }
 
-/// The body's pose schedule: `settle` frames (at least one) from rest into the motion's first
-/// frame, then the motion. Half the settling holds the rest pose so the garment drapes on a still
-/// body; frame 0 is the rest pose the garment was modelled around.
-struct Schedule {
-    settle: usize,
-    poses: Vec<f32>,
-    trans: Vec<f32>,
-    joints: usize,
-}
-
-impl Schedule {
-    fn new(model: &BodyModel, motion: &Motion, settle_seconds: f32) -> Result<Self> {
-        let joints = model.num_joints();
-        let poses = motion.poses_for(model)?;
-        let settle = ((settle_seconds.max(0.0) * motion.fps).round() as usize).max(1);
-        let hold = settle / 2;
-        let mut all_poses = Vec::with_capacity((settle + motion.num_frames()) * 3 * joints);
-        let mut all_trans = Vec::new();
-        for k in 0..settle {
-            let t = if k < hold { 0.0 } else { (k - hold) as f32 / (settle - hold) as f32 };
-            let w = t * t * (3.0 - 2.0 * t);
-            all_poses.extend(poses[..3 * joints].iter().map(|p| w * p));
-            all_trans.extend(motion.trans[..3].iter().map(|t| w * t));
-        }
-        all_poses.extend_from_slice(&poses);
-        all_trans.extend_from_slice(&motion.trans);
-        Ok(Self { settle, poses: all_poses, trans: all_trans, joints })
-    }
-
-    fn len(&self) -> usize {
-        self.trans.len() / 3
-    }
-
-    fn pose(&self, k: usize) -> (&[f32], &[f32]) {
-        (&self.poses[3 * self.joints * k..3 * self.joints * (k + 1)], &self.trans[3 * k..3 * k + 3])
-    }
-}
-
 /// Where a run stands: the next schedule frame to reach, and what it has recorded.
 struct Progress {
     next: usize,
@@ -274,7 +238,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         Cloth::new(&garment, &material, &pins.fixed).with_context(|| garment_path.display().to_string())?;
     let model = load_body(&args.body.body)?;
     let motion = args.clip.load()?;
-    let schedule = Schedule::new(&model, &motion, args.settle)?;
+    let schedule = Settling::new(&model, &motion, args.settle)?;
     let shaped = shape_body(&model, &args.body.betas)?;
     let faces = model.template_mesh().faces;
     let body_at = |k: usize| -> Result<Vec<[f32; 3]>> {

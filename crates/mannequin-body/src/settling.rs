@@ -1,0 +1,72 @@
+//! A motion preceded by a settling period: a garment modelled around the body at rest must drape
+//! on a still body before the body moves, so half the settling holds the rest pose and the other
+//! half eases from rest into the motion's first frame.
+
+use crate::{BodyError, BodyModel, Motion};
+
+/// The body's pose schedule: `settle` frames (at least one) from rest into the motion's first
+/// frame, then the motion. Frame 0 is the rest pose.
+#[derive(Debug, Clone)]
+pub struct Settling {
+    /// Frames before the motion's first.
+    pub settle: usize,
+    poses: Vec<f32>,
+    trans: Vec<f32>,
+    joints: usize,
+}
+
+impl Settling {
+    pub fn new(model: &BodyModel, motion: &Motion, settle_seconds: f32) -> Result<Self, BodyError> {
+        let joints = model.num_joints();
+        let poses = motion.poses_for(model)?;
+        let settle = ((settle_seconds.max(0.0) * motion.fps).round() as usize).max(1);
+        let hold = settle / 2;
+        let mut all_poses = Vec::with_capacity((settle + motion.num_frames()) * 3 * joints);
+        let mut all_trans = Vec::new();
+        for k in 0..settle {
+            // Smoothstep, so the body starts and arrives without a jolt.
+            let t = if k < hold { 0.0 } else { (k - hold) as f32 / (settle - hold) as f32 };
+            let w = t * t * (3.0 - 2.0 * t);
+            all_poses.extend(poses[..3 * joints].iter().map(|p| w * p));
+            all_trans.extend(motion.trans[..3].iter().map(|t| w * t));
+        }
+        all_poses.extend_from_slice(&poses);
+        all_trans.extend_from_slice(&motion.trans);
+        Ok(Self { settle, poses: all_poses, trans: all_trans, joints })
+    }
+
+    /// Frames in all, settling included.
+    pub fn len(&self) -> usize {
+        self.trans.len() / 3
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.trans.is_empty()
+    }
+
+    /// Frame `k`'s axis-angle pose (3 per joint) and translation.
+    pub fn pose(&self, k: usize) -> (&[f32], &[f32]) {
+        (&self.poses[3 * self.joints * k..3 * self.joints * (k + 1)], &self.trans[3 * k..3 * k + 3])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn holds_rest_then_eases_into_the_first_frame() {
+        let model = BodyModel::default_body_lod1();
+        let motion = Motion::walk_cycle(0.5, 30.0);
+        let s = Settling::new(&model, &motion, 0.4).unwrap();
+        assert_eq!((s.settle, s.len()), (12, 12 + motion.num_frames()));
+        let first = motion.poses_for(&model).unwrap();
+        assert!(s.pose(0).0.iter().chain(s.pose(5).0).all(|&p| p == 0.0), "the first half holds rest");
+        // Smoothstep at t = 1/6 gives 2/27 of the first frame.
+        let w = 2.0 / 27.0;
+        for (p, q) in s.pose(7).0.iter().zip(&first) {
+            assert!((p - w * q).abs() <= 1e-6 * q.abs().max(1.0), "{p} vs {}", w * q);
+        }
+        assert_eq!(s.pose(12).0, &first[..3 * model.num_joints()], "the motion follows unchanged");
+    }
+}
