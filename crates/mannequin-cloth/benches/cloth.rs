@@ -78,7 +78,15 @@ fn newton_times(frames: usize) -> Option<serde_json::Value> {
     let out =
         std::process::Command::new(&python).args([script, "time", "--frames", &frames.to_string()]).output();
     match out {
-        Ok(o) if o.status.success() => serde_json::from_slice(&o.stdout).ok(),
+        // Warp logs to stdout too: the JSON is the last line.
+        Ok(o) if o.status.success() => {
+            let stdout = String::from_utf8_lossy(&o.stdout);
+            let parsed = stdout.lines().last().and_then(|l| serde_json::from_str(l).ok());
+            if parsed.is_none() {
+                println!("  Newton printed no JSON on its last line: {stdout}");
+            }
+            parsed
+        }
         Ok(o) => {
             println!("  Newton failed: {}", String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or(""));
             None
