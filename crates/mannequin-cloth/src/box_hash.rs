@@ -113,6 +113,17 @@ impl BoxHash {
         let h = self.grid.bucket(self.grid.cell_of(p));
         &self.items[self.starts[h] as usize..self.starts[h + 1] as usize]
     }
+
+    /// The boxes of `boxes` (the ones built from) that contain `p`, each once, in ascending order:
+    /// a box listed twice in one bucket (two of its cells hashed alike) is listed consecutively.
+    pub fn containing<'a>(&'a self, boxes: &'a [Aabb], p: Vec3) -> impl Iterator<Item = u32> + 'a {
+        let listed = self.query(p);
+        listed
+            .iter()
+            .enumerate()
+            .filter(move |&(k, &b)| (k == 0 || listed[k - 1] != b) && boxes[b as usize].contains(p))
+            .map(|(_, &b)| b)
+    }
 }
 
 #[cfg(test)]
@@ -139,6 +150,10 @@ mod tests {
                     assert!(listed.contains(&(i as u32)), "box {i} contains {p} but is not listed");
                 }
             }
+            // `containing` is exactly the boxes holding p, each once, ascending; a cell of 0.1
+            // over a 1024-bucket table makes listing one box twice in a bucket likely.
+            let all: Vec<u32> = (0..boxes.len() as u32).filter(|&i| boxes[i as usize].contains(p)).collect();
+            assert_eq!(hash.containing(&boxes, p).collect::<Vec<_>>(), all, "at {p}");
         }
     }
 }

@@ -12,7 +12,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::crossing::{between, coplanar_time, volume};
-use super::{Neighbours, Reach, push_weights};
+use super::{Neighbours, Reach, push_apart};
 use crate::box_hash::{Aabb, BoxHash};
 
 /// Closest points this close to an edge's end (as a fraction of it) count as at the end.
@@ -104,21 +104,10 @@ impl EdgeEdge {
                 let e1 = edges[first as usize];
                 let (p1, p2) = (at(e1[0]), at(e1[1]));
                 let middle = 0.5 * (p1 + p2);
-                let mut candidates: Vec<u32> = hash
-                    .query(middle)
-                    .iter()
-                    .copied()
+                hash.containing(boxes, middle)
                     .filter(|&second| {
-                        let e2 = edges[second as usize];
-                        second > first
-                            && boxes[second as usize].contains(middle)
-                            && !e2.iter().any(|v| e1.contains(v))
+                        second > first && !edges[second as usize].iter().any(|v| e1.contains(v))
                     })
-                    .collect();
-                candidates.sort_unstable();
-                candidates.dedup();
-                candidates
-                    .into_iter()
                     .filter_map(|second| {
                         let e2 = edges[second as usize];
                         let (q1, q2) = (at(e2[0]), at(e2[1]));
@@ -172,14 +161,7 @@ impl EdgeEdge {
             }
             let (s, t) = (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
             let share = [1.0 - s, s, t - 1.0, -t];
-            let Some(moves) = push_weights(particles.map(|i| inverse_mass[i as usize]), share) else {
-                continue;
-            };
-            let push = -violation * side * normal;
-            for k in 0..4 {
-                let p = Vec3::from(positions[particles[k] as usize]);
-                positions[particles[k] as usize] = (p + moves[k] * push).to_array();
-            }
+            push_apart(positions, particles, inverse_mass, share, -violation * side * normal);
         }
     }
 }

@@ -61,6 +61,24 @@ fn push_weights(inverse_mass: [f32; 4], share: [f32; 4]) -> Option<[f32; 4]> {
     (denominator > 0.0).then(|| [0, 1, 2, 3].map(|k| inverse_mass[k] * share[k] / denominator))
 }
 
+/// Moves four particles along `push` (the full correction, as if the free corners carried it all)
+/// in the shares [`push_weights`] gives them.
+fn push_apart(
+    positions: &mut [[f32; 3]],
+    particles: [u32; 4],
+    inverse_mass: &[f32],
+    share: [f32; 4],
+    push: Vec3,
+) {
+    let Some(moves) = push_weights(particles.map(|i| inverse_mass[i as usize]), share) else {
+        return;
+    };
+    for k in 0..4 {
+        let p = &mut positions[particles[k] as usize];
+        *p = (Vec3::from(*p) + moves[k] * push).to_array();
+    }
+}
+
 #[derive(Debug, Clone)]
 pub(crate) struct SelfContacts {
     neighbours: Neighbours,

@@ -11,7 +11,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::crossing::{between, coplanar_time, volume};
-use super::{Neighbours, Reach, push_weights};
+use super::{Neighbours, Reach, push_apart};
 use crate::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 use crate::box_hash::{Aabb, BoxHash};
 
@@ -46,16 +46,8 @@ impl VertexTriangle {
             .into_par_iter()
             .map(|vertex| {
                 let q = at(vertex);
-                let mut candidates: Vec<u32> = hash
-                    .query(q)
-                    .iter()
-                    .copied()
-                    .filter(|&t| boxes[t as usize].contains(q) && !faces[t as usize].contains(&vertex))
-                    .collect();
-                candidates.sort_unstable();
-                candidates.dedup();
-                candidates
-                    .into_iter()
+                hash.containing(boxes, q)
+                    .filter(|&t| !faces[t as usize].contains(&vertex))
                     .filter_map(|triangle| {
                         let tri = faces[triangle as usize];
                         let [a, b, c] = tri.map(at);
@@ -109,14 +101,7 @@ impl VertexTriangle {
             }
             let bary = bary.map(|x| x.clamp(0.0, 1.0));
             let share = [-bary[0], -bary[1], -bary[2], 1.0];
-            let Some(moves) = push_weights(particles.map(|i| inverse_mass[i as usize]), share) else {
-                continue;
-            };
-            let push = -violation * side * normal;
-            for k in 0..4 {
-                let p = Vec3::from(positions[particles[k] as usize]);
-                positions[particles[k] as usize] = (p + moves[k] * push).to_array();
-            }
+            push_apart(positions, particles, inverse_mass, share, -violation * side * normal);
         }
     }
 }
