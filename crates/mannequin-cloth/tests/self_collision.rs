@@ -11,8 +11,10 @@ use mannequin_mesh::TriMesh;
 const FLOOR_MIN: [f32; 3] = [-1.0, -0.2, -1.0];
 const FLOOR_MAX: [f32; 3] = [1.0, 0.0, 1.0];
 
-/// Runs `frames` frames over a still floor; returns the most intersecting pairs seen in a frame,
-/// the pairs at the end, and the nearest any particle came to the floor.
+/// Runs `frames` frames over a still floor; returns the most intersecting pairs seen in a frame
+/// (every frame is counted with self-collision on; with it off, where the count only has to show
+/// a tangle, the last frame alone), the pairs at the end, and the nearest any particle came to
+/// the floor.
 fn drop_on_floor(sheet: &TriMesh, self_collision: bool, frames: usize) -> (usize, usize, f32) {
     let floor = box_mesh(FLOOR_MIN, FLOOR_MAX);
     let cloth = Cloth::new(sheet, &Material::named("cotton").unwrap(), &[]).unwrap();
@@ -21,11 +23,14 @@ fn drop_on_floor(sheet: &TriMesh, self_collision: bool, frames: usize) -> (usize
     let (mut worst, mut nearest) = (0, f32::INFINITY);
     for _ in 0..frames {
         sim.step_frame(&floor.positions, &floor.positions, 1.0 / 60.0).unwrap();
-        worst = worst.max(quality::self_intersecting_pairs(sim.positions(), &sheet.faces));
+        if self_collision {
+            worst = worst.max(quality::self_intersecting_pairs(sim.positions(), &sheet.faces));
+        }
         nearest =
             sim.positions().iter().map(|&p| box_distance(p, FLOOR_MIN, FLOOR_MAX)).fold(nearest, f32::min);
     }
-    (worst, quality::self_intersecting_pairs(sim.positions(), &sheet.faces), nearest)
+    let last = quality::self_intersecting_pairs(sim.positions(), &sheet.faces);
+    (worst.max(last), last, nearest)
 }
 
 /// A long strip held upright, tilted a little, and let go: it piles up on the floor in folds.
@@ -43,7 +48,6 @@ fn a_strip_dropped_on_the_floor_piles_up_without_intersecting() {
 
 /// A sheet standing up from the floor along a crease falls over onto its own lying half.
 #[test]
-#[ignore = "self-collision does not yet keep a folding sheet in two layers, and runs for minutes on it; issue 18 stays open"]
 fn a_sheet_folding_over_onto_itself_stays_in_two_layers() {
     let (n, spacing) = (30usize, 0.01f32);
     let mut sheet = grid(n, 2 * n, spacing, [-0.15, 0.0051, -0.3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);

@@ -5,6 +5,7 @@
 mod exact;
 mod inside;
 mod self_intersection;
+mod separating_axis;
 mod strain;
 mod triangle_intersection;
 

@@ -5,12 +5,18 @@
 use std::cmp::Ordering::{self, Equal, Greater, Less};
 
 use super::exact::{orient2d, orient3d};
+use super::separating_axis::certainly_apart;
 
 pub(crate) type Point = [f64; 3];
 
 /// True when the closed triangles `p` and `q` intersect (touching counts). A degenerate triangle
 /// (its corners on one line) meets nothing.
 pub(crate) fn triangles_intersect(p: [Point; 3], q: [Point; 3]) -> bool {
+    !certainly_apart(p, q) && exactly_intersect(p, q)
+}
+
+/// [`triangles_intersect`] with the exact predicates alone.
+fn exactly_intersect(p: [Point; 3], q: [Point; 3]) -> bool {
     if degenerate(p) || degenerate(q) {
         return false;
     }
@@ -146,5 +152,40 @@ mod tests {
     fn degenerate_triangles_meet_nothing() {
         let sliver = [[0.5, 0.5, -1.0], [0.5, 0.5, 0.0], [0.5, 0.5, 1.0]];
         assert!(!triangles_intersect(FLOOR, sliver));
+    }
+
+    /// The fast separation test never changes an answer: on pairs built to touch, nearly touch,
+    /// share a plane or cross, the filtered and the exact-only tests agree.
+    #[test]
+    fn the_separation_filter_agrees_with_the_exact_test() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut crossing, mut apart) = (0, 0);
+        for k in 0..20_000 {
+            let p: [Point; 3] = std::array::from_fn(|_| [next(), next(), next()]);
+            let mut q: [Point; 3] = std::array::from_fn(|_| [next(), next(), next()]);
+            match k % 4 {
+                // In p's plane (z flattened), as a flat sheet's triangles are.
+                0 => {
+                    let flat = |t: [Point; 3]| t.map(|x| [x[0], x[1], 0.25]);
+                    let (p, q) = (flat(p), flat(q));
+                    assert_eq!(triangles_intersect(p, q), exactly_intersect(p, q), "{p:?} {q:?}");
+                    continue;
+                }
+                // Sharing a corner's position, or one a hair away from it.
+                1 => q[0] = p[1],
+                2 => q[0] = [p[1][0] + 1e-13, p[1][1], p[1][2]],
+                _ => {}
+            }
+            let exact = exactly_intersect(p, q);
+            assert_eq!(triangles_intersect(p, q), exact, "{p:?} {q:?}");
+            if exact { crossing += 1 } else { apart += 1 }
+        }
+        assert!(crossing > 1000 && apart > 1000, "{crossing} crossing, {apart} apart");
     }
 }
