@@ -18,6 +18,9 @@ use mannequin_cloth::{Attachment, Body, Cloth, Material, PhaseTimes, Settings, S
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::ring_tube::RingLayout;
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 fn arg(name: &str, default: usize) -> usize {
     let args: Vec<String> = std::env::args().collect();
     args.iter()
@@ -25,22 +28,6 @@ fn arg(name: &str, default: usize) -> usize {
         .and_then(|i| args.get(i + 1))
         .and_then(|v| v.parse().ok())
         .unwrap_or(default)
-}
-
-/// A horizontal `nx` × `ny` grid 1 cm apart, in the x–z plane at height 1 m.
-fn grid(nx: usize, ny: usize) -> TriMesh {
-    let spacing = 0.01;
-    let positions =
-        (0..ny).flat_map(|j| (0..nx).map(move |i| [i as f32 * spacing, 1.0, j as f32 * spacing])).collect();
-    let at = |i: usize, j: usize| (j * nx + i) as u32;
-    let faces = (0..ny - 1)
-        .flat_map(|j| {
-            (0..nx - 1).flat_map(move |i| {
-                [[at(i, j), at(i, j + 1), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i + 1, j)]]
-            })
-        })
-        .collect();
-    TriMesh::new(positions, faces)
 }
 
 fn ms(d: Duration) -> f64 {
@@ -55,7 +42,8 @@ fn breakdown(times: &PhaseTimes, frames: usize) {
 
 /// Mannequin on a pinned grid: ms per frame over `frames` frames.
 fn grid_run(nx: usize, ny: usize, self_collision: bool, frames: usize) -> f64 {
-    let mesh = grid(nx, ny);
+    // Horizontal, 1 cm apart, at height 1 m.
+    let mesh = common::grid(nx, ny, 0.01, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
     let pins: Vec<u32> = (0..nx as u32).collect();
     let cloth = Cloth::new(&mesh, &Material::named("cotton").expect("cotton"), &pins).expect("cloth");
     let settings = Settings { substeps: 10, self_collision, ..Settings::default() };
