@@ -63,15 +63,29 @@ fn skirt(dir: &Path) -> (PathBuf, usize) {
     (path, segments)
 }
 
+/// The skirt in `dir`, a pins file attaching its waistband ring, and a walk of `seconds` at 30
+/// fps: what each simulation test starts from.
+struct SkirtOnAWalk {
+    garment: PathBuf,
+    pins: PathBuf,
+    walk: PathBuf,
+    segments: usize,
+}
+
+fn skirt_on_a_walk(dir: &Path, seconds: &str) -> SkirtOnAWalk {
+    let (garment, segments) = skirt(dir);
+    let pins = dir.join("pins.json");
+    std::fs::write(&pins, serde_json::json!({ "attached": (0..segments).collect::<Vec<_>>() }).to_string())
+        .unwrap();
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "--seconds", seconds, "--fps", "30", "-o", s(&walk)]));
+    SkirtOnAWalk { garment, pins, walk, segments }
+}
+
 #[test]
 fn a_skirt_walks_with_the_body() {
     let dir = scratch("cloth-skirt");
-    let (garment, segments) = skirt(&dir);
-    let pins = dir.join("pins.json");
-    let waist: Vec<usize> = (0..segments).collect();
-    std::fs::write(&pins, serde_json::json!({ "attached": waist }).to_string()).unwrap();
-    let walk = dir.join("walk.npz");
-    ok(mannequin(&["motion", "walk", "--seconds", "0.5", "--fps", "30", "-o", s(&walk)]));
+    let SkirtOnAWalk { garment, pins, walk, segments } = skirt_on_a_walk(&dir, "0.5");
     let out = dir.join("sim");
     let run = |extra: &[&str]| {
         let mut a =
@@ -133,12 +147,7 @@ fn a_skirt_walks_with_the_body() {
 #[test]
 fn self_collision_keeps_the_folds_apart() {
     let dir = scratch("cloth-skirt-self");
-    let (garment, segments) = skirt(&dir);
-    let pins = dir.join("pins.json");
-    std::fs::write(&pins, serde_json::json!({ "attached": (0..segments).collect::<Vec<_>>() }).to_string())
-        .unwrap();
-    let walk = dir.join("walk.npz");
-    ok(mannequin(&["motion", "walk", "--seconds", "0.3", "--fps", "30", "-o", s(&walk)]));
+    let SkirtOnAWalk { garment, pins, walk, .. } = skirt_on_a_walk(&dir, "0.3");
     let pairs = |extra: &[&str]| {
         let out = dir.join("sim");
         let (g, p, w, o) = (s(&garment), s(&pins), s(&walk), s(&out));
@@ -197,12 +206,7 @@ fn bad_garments_are_one_line_errors() {
 #[test]
 fn a_killed_run_resumes_to_the_same_frames() {
     let dir = scratch("cloth-resume");
-    let (garment, segments) = skirt(&dir);
-    let pins = dir.join("pins.json");
-    std::fs::write(&pins, serde_json::json!({ "attached": (0..segments).collect::<Vec<_>>() }).to_string())
-        .unwrap();
-    let walk = dir.join("walk.npz");
-    ok(mannequin(&["motion", "walk", "--seconds", "0.4", "--fps", "30", "-o", s(&walk)]));
+    let SkirtOnAWalk { garment, pins, walk, .. } = skirt_on_a_walk(&dir, "0.4");
     let args = |out: &Path| -> Vec<String> {
         let a = ["cloth", "simulate", "--garment", s(&garment), "--pin", s(&pins), "--motion", s(&walk)];
         let b = ["--settle", "0.3", "--checkpoint-every", "4", "--out", s(out)];
