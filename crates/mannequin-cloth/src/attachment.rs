@@ -3,9 +3,9 @@
 
 use glam::Vec3;
 
-use crate::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 use crate::body::Body;
 use crate::error::ClothError;
+use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Attachment {

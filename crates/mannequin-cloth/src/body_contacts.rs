@@ -9,10 +9,10 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::barycentric::{at_barycentric, closest_barycentric};
 use crate::body::Body;
 use crate::box_hash::{Aabb, BoxHash};
 use crate::error::ClothError;
+use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric};
 
 /// A window of substeps shares one hash while the body moves less than this fraction of a cell
 /// in it, so the swept boxes stay about a cell in size.

@@ -2,7 +2,6 @@
 //! bending constraints, kept off itself and off an animated body.
 
 mod attachment;
-mod barycentric;
 mod bending;
 mod body;
 mod body_contacts;

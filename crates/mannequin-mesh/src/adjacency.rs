@@ -44,6 +44,44 @@ pub fn face_neighbors(faces: &[[u32; 3]]) -> Vec<[Option<u32>; 3]> {
     neighbors
 }
 
+/// The boundary loops of a manifold mesh: each a cycle of vertices following the faces' winding
+/// along edges that only one face has. A vertex where two loops touch starts a new loop at its
+/// second outgoing edge.
+pub fn boundary_loops(faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut count: std::collections::HashMap<[u32; 2], u32> = std::collections::HashMap::new();
+    for &t in faces {
+        for (a, b, _) in face_edges(t) {
+            *count.entry(sorted(a, b)).or_insert(0) += 1;
+        }
+    }
+    let mut next: std::collections::BTreeMap<u32, Vec<u32>> = std::collections::BTreeMap::new();
+    for &t in faces {
+        for (a, b, _) in face_edges(t) {
+            if count[&sorted(a, b)] == 1 {
+                next.entry(a).or_default().push(b);
+            }
+        }
+    }
+    let mut loops = Vec::new();
+    while let Some((&start, _)) = next.iter().next() {
+        let mut cycle = vec![start];
+        let mut at = start;
+        while let Some(outgoing) = next.get_mut(&at) {
+            let to = outgoing.pop().unwrap_or(start);
+            if outgoing.is_empty() {
+                next.remove(&at);
+            }
+            if to == start {
+                break;
+            }
+            cycle.push(to);
+            at = to;
+        }
+        loops.push(cycle);
+    }
+    loops
+}
+
 /// The three directed edges of a face with the corner each starts at.
 fn face_edges(t: [u32; 3]) -> [(u32, u32, usize); 3] {
     [(t[0], t[1], 0), (t[1], t[2], 1), (t[2], t[0], 2)]
@@ -63,6 +101,25 @@ mod tests {
         assert_eq!(edges(&f), vec![[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]);
         assert_eq!(one_rings(4, &f), vec![vec![1, 2], vec![0, 2, 3], vec![0, 1, 3], vec![1, 2]]);
         assert_eq!(face_neighbors(&f), vec![[None, Some(1), None], [Some(0), None, None]]);
+    }
+
+    /// A quad strip closed into a ring (a tube of 4 × 1 quads) has two boundary loops of 4,
+    /// running in opposite directions around the tube.
+    #[test]
+    fn a_tube_has_two_boundary_loops() {
+        let mut f = Vec::new();
+        for k in 0..4u32 {
+            let (a, b) = (k, (k + 1) % 4);
+            f.push([a, b, b + 4]);
+            f.push([a, b + 4, a + 4]);
+        }
+        let mut loops = boundary_loops(&f);
+        loops.sort();
+        assert_eq!(loops.len(), 2);
+        assert_eq!(loops[0].len(), 4);
+        assert!(loops[0].iter().all(|&v| v < 4) && loops[1].iter().all(|&v| v >= 4));
+        assert_eq!(loops[0], vec![0, 1, 2, 3]);
+        assert_eq!(loops[1], vec![4, 7, 6, 5]);
     }
 
     #[test]

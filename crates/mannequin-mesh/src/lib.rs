@@ -2,6 +2,9 @@
 
 pub mod adjacency;
 pub mod area;
+pub mod barycentric;
+pub mod clip;
+pub mod closest_point;
 pub mod file_error;
 pub mod gltf;
 pub mod gradient;
@@ -11,11 +14,13 @@ pub mod normals;
 pub mod obj;
 pub mod pc2;
 pub mod ply;
+pub mod remesh;
 pub mod ring_tube;
 pub mod subdivide;
 pub mod tri_mesh;
 
 pub use area::double_areas;
+pub use closest_point::{ClosestPoint, SurfacePoint};
 pub use file_error::MeshFileError;
 pub use gltf::{MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, write_glb, write_scene_glb};
 pub use gradient::gradient_operator;

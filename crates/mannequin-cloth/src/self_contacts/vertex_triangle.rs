@@ -12,8 +12,8 @@ use rayon::prelude::*;
 
 use super::crossing::{between, coplanar_time, volume};
 use super::{Neighbours, Reach, push_apart};
-use crate::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 use crate::box_hash::{Aabb, BoxHash};
+use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 
 /// A vertex counts as over a triangle while its barycentric coordinates stay above this, so it
 /// cannot slip between two neighbouring triangles through rounding.

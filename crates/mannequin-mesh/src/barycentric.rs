@@ -7,7 +7,7 @@ use glam::Vec3;
 
 /// Barycentric coordinates `[u, v, w]` of the point of triangle (a, b, c) closest to `p`, so that
 /// the point is u·a + v·b + w·c.
-pub(crate) fn closest_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+pub fn closest_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
@@ -47,13 +47,13 @@ pub(crate) fn closest_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3
     [1.0 - v - w, v, w]
 }
 
-pub(crate) fn at_barycentric([u, v, w]: [f32; 3], a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+pub fn at_barycentric([u, v, w]: [f32; 3], a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     u * a + v * b + w * c
 }
 
 /// Barycentric coordinates of `p`, a point of the plane of (a, b, c); outside the triangle some
 /// are negative. A degenerate triangle gives its first corner.
-pub(crate) fn plane_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+pub fn plane_barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
     let (v0, v1, v2) = (b - a, c - a, p - a);
     let (d00, d01, d11, d20, d21) = (v0.dot(v0), v0.dot(v1), v1.dot(v1), v2.dot(v0), v2.dot(v1));
     let denominator = d00 * d11 - d01 * d01;
