@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use mannequin_body::kinematics::{skinning_transforms, world_transforms};
 use mannequin_body::lbs::frame_rotations;
 use mannequin_body::smpl_joint::{L_ANKLE, L_HIP, L_KNEE, PELVIS, R_ANKLE, R_HIP, R_KNEE, SPINE1};
-use mannequin_body::weight_transfer::transfer_weights;
+use mannequin_body::weight_transfer::{KernelWidth, transfer_weights};
 use mannequin_mesh::UvLayout;
 use mannequin_mesh::gltf::influences::top_four;
 use mannequin_mesh::ring_tube::RingLayout;
@@ -238,7 +238,8 @@ fn ring_skirt(body: &Canonical, centre: Vec3, (waist, hem): (f32, f32), layout: 
         }
     }
     let j = body.num_joints();
-    let weights = transfer_weights(&body.vertices, &body.weights, j, &positions, SKIN_SIGMA);
+    let weights =
+        transfer_weights(&body.vertices, &body.weights, j, &positions, KernelWidth::Fixed(SKIN_SIGMA));
     let influences =
         weights.chunks_exact(j).map(|row| top_four(row).unwrap_or(([0; 4], [1.0, 0.0, 0.0, 0.0]))).collect();
     let (faces, uv) = layout.tube();

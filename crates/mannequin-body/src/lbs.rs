@@ -199,6 +199,47 @@ pub fn pose_frames(
     Ok(PosedFrames { num_frames: f, vertices, joints, transforms })
 }
 
+/// T(β, θ) of the thesis for one frame: the shaped rest body plus the pose correctives B_P(θ),
+/// before skinning. A garment bound to the body takes its rest shape from it (Eq. 3.2).
+pub fn pose_corrected(model: &BodyModel, shaped: &ShapedBody, pose: &[f32]) -> Result<Vec<f32>, BodyError> {
+    frame_count(model, pose, &[0.0; 3])?;
+    let mut vertices = shaped.vertices.clone();
+    let p = model.num_pose_features();
+    if p > 0 {
+        let feats = pose_features(&frame_rotations(pose), model.num_joints());
+        let len = vertices.len();
+        faer::linalg::matmul::matmul(
+            MatMut::from_row_major_slice_mut(&mut vertices, 1, len),
+            Accum::Add,
+            MatRef::from_row_major_slice(&feats, 1, p),
+            MatRef::from_row_major_slice(model.posedirs(), p, len),
+            1.0f32,
+            Par::Seq,
+        );
+    }
+    Ok(vertices)
+}
+
+/// One frame's skinning transforms A_k with the translation added: what LBS blends for any point
+/// skinned to this body with its own weights (a garment, Eq. 3.3).
+pub fn frame_skinning(
+    model: &BodyModel,
+    shaped: &ShapedBody,
+    pose: &[f32],
+    transl: &[f32],
+) -> Result<Vec<Affine3A>, BodyError> {
+    frame_count(model, pose, transl)?;
+    let world = world_transforms(model.parents(), &frame_rotations(pose), &shaped.joints);
+    let t = Vec3A::from_slice(transl);
+    Ok(skinning_transforms(&world, &shaped.joints)
+        .into_iter()
+        .map(|mut a| {
+            a.translation += t;
+            a
+        })
+        .collect())
+}
+
 /// One-call forward for a batch that shares one shape.
 pub fn forward(
     model: &BodyModel,

@@ -18,7 +18,7 @@ pub mod walk_cycle;
 pub mod weight_transfer;
 
 pub use error::BodyError;
-pub use lbs::{PosedFrames, ShapedBody, forward, pose_frames, shape_body};
+pub use lbs::{PosedFrames, ShapedBody, forward, frame_skinning, pose_corrected, pose_frames, shape_body};
 pub use lbs_tensor::{BodyTensors, PosedTensors, Rig, forward_tensors, rodrigues_tensor, skin_tensors};
 pub use model::{BodyModel, BodyModelParts, ModelFamily};
 pub use motion::Motion;
