@@ -19,6 +19,7 @@ pub struct Material {
     pub bend_compliance: f32,
     pub friction: f32,
     pub damping: f32,
+    pub strain_limit: f32,
 }
 
 pub const MATERIAL_NAMES: [&str; 5] = ["cotton", "denim", "silk", "jersey", "leather"];
@@ -32,6 +33,7 @@ const COTTON: Material = Material {
     bend_compliance: 2e5,
     friction: 0.5,
     damping: 2.4,
+    strain_limit: 0.05,
 };
 
 /// Denim: ~400 g/m² (12 oz/yd²); stiff twill, ~5000 N/m; bending ~0.5 gf·cm²/cm (5e-5 N·m);
@@ -43,6 +45,7 @@ const DENIM: Material = Material {
     bend_compliance: 2e4,
     friction: 0.6,
     damping: 0.9,
+    strain_limit: 0.03,
 };
 
 /// Silk charmeuse: ~80 g/m²; ~1000 N/m; bending ~0.01 gf·cm²/cm (1e-6 N·m); slippery, μ ≈ 0.25.
@@ -53,6 +56,7 @@ const SILK: Material = Material {
     bend_compliance: 1e6,
     friction: 0.25,
     damping: 4.5,
+    strain_limit: 0.05,
 };
 
 /// Cotton jersey (a knit): ~180 g/m²; knits stretch easily, ~100 N/m; bending ~0.02 gf·cm²/cm
@@ -64,6 +68,7 @@ const JERSEY: Material = Material {
     bend_compliance: 5e5,
     friction: 0.5,
     damping: 2.0,
+    strain_limit: 0.25,
 };
 
 /// Garment leather, ~1 mm: ~800 g/m²; E ≈ 20 MPa gives ~2e4 N/m; a plate's B = E·t³/12 with
@@ -75,6 +80,7 @@ const LEATHER: Material = Material {
     bend_compliance: 2e3,
     friction: 0.4,
     damping: 0.45,
+    strain_limit: 0.08,
 };
 
 impl Material {
@@ -94,6 +100,7 @@ impl Material {
             ("bend_compliance", self.bend_compliance),
             ("friction", self.friction),
             ("damping", self.damping),
+            ("strain_limit", self.strain_limit),
         ];
         for (field, value) in fields {
             if !(value.is_finite() && value >= 0.0) {

@@ -15,6 +15,7 @@ fn material(density: f32, stretch: f32, bend: f32, damping: f32) -> Material {
         bend_compliance: bend,
         friction: 0.0,
         damping,
+        strain_limit: 0.05,
     }
 }
 
