@@ -1,0 +1,23 @@
+//! Garment errors: one line each, naming the field or file at fault.
+
+#[derive(Debug, thiserror::Error)]
+pub enum GarmentError {
+    #[error("category: unknown name {name:?}; the categories are {}", crate::category::CATEGORY_NAMES.join(", "))]
+    UnknownCategory { name: String },
+    #[error("size: unknown name {name:?}; the sizes are {}", crate::fit::SIZE_NAMES.join(", "))]
+    UnknownSize { name: String },
+    #[error("{field}: {reason}")]
+    Invalid { field: String, reason: String },
+    #[error("{path}: {reason}")]
+    File { path: String, reason: String },
+    #[error(transparent)]
+    Body(#[from] mannequin_body::BodyError),
+    #[error(transparent)]
+    Io(#[from] mannequin_io::IoError),
+}
+
+impl GarmentError {
+    pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Self::Invalid { field: field.into(), reason: reason.into() }
+    }
+}

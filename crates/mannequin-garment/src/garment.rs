@@ -1,0 +1,117 @@
+//! A garment template: its mesh on the body it was made for, and how each vertex hangs on that
+//! body, as the thesis's Eq. 3.1 writes it: G^g = I^g T(β^g, 0) + D^g. Row i of the indicator
+//! I^g is a point of the body surface (a face and barycentric weights: the MakeHuman clothing
+//! form of MGN's vertex selection), and D^g the offset from it.
+
+use glam::Vec3;
+use mannequin_mesh::{ClosestPoint, SurfacePoint, TriMesh, UvLayout};
+use serde::{Deserialize, Serialize};
+
+use crate::category::Category;
+use crate::fit::Fit;
+
+/// How the template was made: enough to make it again on another body model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Recipe {
+    pub category: Category,
+    pub fit: Fit,
+    /// Target edge length of the remeshed garment (m).
+    pub edge_length: f32,
+    /// A `mannequin-cloth` material name.
+    pub material: String,
+    /// The body model the template hangs on (`default`, or a model file's name) and its shape.
+    pub body: String,
+    pub betas: Vec<f32>,
+    /// The body model's vertex and face counts: a template is refused on another model.
+    pub body_vertices: usize,
+    pub body_faces: usize,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Garment {
+    pub recipe: Recipe,
+    /// G^g: the garment at rest on the template body, with its faces and UVs.
+    pub mesh: TriMesh,
+    /// I^g: per garment vertex, its point on the template body's surface.
+    pub binding: Vec<SurfacePoint>,
+    /// D^g (Eq. 3.1), per garment vertex.
+    pub offsets: Vec<[f32; 3]>,
+}
+
+impl Garment {
+    /// Binds each vertex of `mesh` (the garment on the body whose rest vertices are `body`) to its
+    /// closest body surface point and stores the rest as offsets: Eq. 3.1.
+    pub fn bind(recipe: Recipe, mesh: TriMesh, body: &[[f32; 3]], body_faces: &[[u32; 3]]) -> Garment {
+        let index = ClosestPoint::new(body, body_faces, 0.03);
+        let (binding, offsets) = mesh
+            .positions
+            .iter()
+            .map(|&g| {
+                let g = Vec3::from(g);
+                let (point, on_body) =
+                    index.query(g).unwrap_or((SurfacePoint { face: 0, bary: [1.0, 0.0, 0.0] }, g));
+                (point, (g - on_body).to_array())
+            })
+            .unzip();
+        Garment { recipe, mesh, binding, offsets }
+    }
+
+    /// Eq. 3.2 at one body state: I^g T + D^g, with T the body's vertices (rest or pose-corrected).
+    pub fn on_body(&self, body: &[[f32; 3]], body_faces: &[[u32; 3]]) -> Vec<[f32; 3]> {
+        self.binding
+            .iter()
+            .zip(&self.offsets)
+            .map(|(point, d)| (point.locate(body, body_faces) + Vec3::from(*d)).to_array())
+            .collect()
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.mesh.vertex_count()
+    }
+
+    pub fn uv(&self) -> Option<&UvLayout> {
+        self.mesh.uv.as_ref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A two-triangle "body" square and a garment hovering over it: binding then Eq. 3.2 on the
+    /// same body gives the garment back; on the body scaled by s it gives s·(G − D) + D, the
+    /// hand-worked value of I^g (sT) + D^g.
+    #[test]
+    fn eq_3_2_returns_the_template_and_scales_with_the_body() {
+        let body = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let faces = vec![[0, 1, 2], [0, 2, 3]];
+        let garment_points = vec![[0.2, 0.3, 0.05], [0.7, 0.1, 0.02], [0.5, 0.9, 0.1]];
+        let recipe = Recipe {
+            category: Category::Tshirt,
+            fit: Fit::size("M").unwrap(),
+            edge_length: 0.015,
+            material: "cotton".into(),
+            body: "square".into(),
+            betas: vec![],
+            body_vertices: 4,
+            body_faces: 2,
+        };
+        let g = Garment::bind(recipe, TriMesh::new(garment_points.clone(), vec![[0, 1, 2]]), &body, &faces);
+        let same = g.on_body(&body, &faces);
+        for (a, b) in same.iter().zip(&garment_points) {
+            assert!(Vec3::from(*a).distance(Vec3::from(*b)) < 1e-6);
+        }
+        let offsets = [[0.0, 0.0, 0.05], [0.0, 0.0, 0.02], [0.0, 0.0, 0.1]];
+        for (d, e) in g.offsets.iter().zip(offsets) {
+            assert!(Vec3::from(*d).distance(Vec3::from(e)) < 1e-6, "{d:?} vs {e:?}");
+        }
+        let s = 1.7;
+        let scaled: Vec<[f32; 3]> = body.iter().map(|p| p.map(|x| s * x)).collect();
+        let moved = g.on_body(&scaled, &faces);
+        for ((m, p), d) in moved.iter().zip(&garment_points).zip(offsets) {
+            let expected = s * (Vec3::from(*p) - Vec3::from(d)) + Vec3::from(d);
+            assert!(Vec3::from(*m).distance(expected) < 1e-5, "{m:?} vs {expected}");
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! Dressing a body (thesis Eqs. 3.2–3.3): the template's offsets D^g on a body of any shape,
+//! T^g(β, θ) = I^g T(β, θ) + D^g, posed by linear blend skinning with weights carried from the
+//! body to the garment by Gaussian RBFs (NGD §3.5) whose width is each vertex's distance to the
+//! body: a vertex on the body takes that body vertex's weights exactly, and one that stands off
+//! (a hem, a cuff) blends the joints around it instead of tearing along the nearest one.
+
+use glam::{Mat3A, Vec3A};
+use mannequin_body::weight_transfer::{KernelWidth, transfer_weights};
+use mannequin_body::{BodyModel, ShapedBody, frame_skinning, pose_corrected, shape_body};
+
+use crate::error::GarmentError;
+use crate::garment::Garment;
+
+/// The kernel's smallest width (m): small against any edge, so on-body vertices copy their weights.
+const KERNEL_FLOOR: f32 = 1e-4;
+
+/// A garment transferred to one body shape.
+#[derive(Debug, Clone)]
+pub struct Dressed<'a> {
+    garment: &'a Garment,
+    model: &'a BodyModel,
+    faces: Vec<[u32; 3]>,
+    shaped: ShapedBody,
+    /// N × J skinning weights.
+    pub weights: Vec<f32>,
+}
+
+impl<'a> Dressed<'a> {
+    /// `garment` on `model` with shape `betas`; refused when the template hangs on another model.
+    pub fn new(garment: &'a Garment, model: &'a BodyModel, betas: &[f32]) -> Result<Self, GarmentError> {
+        let faces = model.template_mesh().faces;
+        let recipe = &garment.recipe;
+        if recipe.body_vertices != model.num_vertices() || recipe.body_faces != faces.len() {
+            return Err(GarmentError::invalid(
+                "body",
+                format!(
+                    "the garment was made on '{}' ({} vertices, {} faces), this body has {} and {}: \
+                     make it again on this body",
+                    recipe.body,
+                    recipe.body_vertices,
+                    recipe.body_faces,
+                    model.num_vertices(),
+                    faces.len()
+                ),
+            ));
+        }
+        let shaped = shape_body(model, betas)?;
+        let mut dressed = Self { garment, model, faces, shaped, weights: Vec::new() };
+        let rest = dressed.rest();
+        dressed.weights = transfer_weights(
+            &points(&dressed.shaped.vertices),
+            model.weights(),
+            model.num_joints(),
+            &rest,
+            KernelWidth::NearestDistance(KERNEL_FLOOR),
+        );
+        Ok(dressed)
+    }
+
+    /// Eq. 3.2 at rest (θ = 0): I^g T(β, 0) + D^g.
+    pub fn rest(&self) -> Vec<[f32; 3]> {
+        self.garment.on_body(&points(&self.shaped.vertices), &self.faces)
+    }
+
+    /// Eqs. 3.2–3.3: the garment on the body in pose `pose` (3 per joint) moved by `transl`.
+    pub fn posed(&self, pose: &[f32], transl: &[f32]) -> Result<Vec<[f32; 3]>, GarmentError> {
+        let corrected = pose_corrected(self.model, &self.shaped, pose)?;
+        let rest = self.garment.on_body(&points(&corrected), &self.faces);
+        let skinning = frame_skinning(self.model, &self.shaped, pose, transl)?;
+        let joints = self.model.num_joints();
+        Ok(rest
+            .iter()
+            .zip(self.weights.chunks_exact(joints))
+            .map(|(p, w)| {
+                let (mut m, mut t) = (Mat3A::ZERO, Vec3A::ZERO);
+                for (k, &wk) in w.iter().enumerate() {
+                    if wk != 0.0 {
+                        m += skinning[k].matrix3 * wk;
+                        t += skinning[k].translation * wk;
+                    }
+                }
+                (m * Vec3A::from(*p) + t).to_array()
+            })
+            .collect())
+    }
+}
+
+fn points(flat: &[f32]) -> Vec<[f32; 3]> {
+    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
+}

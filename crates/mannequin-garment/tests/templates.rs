@@ -1,0 +1,83 @@
+//! Every category made on the default body: a clean open manifold with the category's openings,
+//! near-uniform triangles at the asked edge length, standing off the body by its ease, and
+//! carried to the template's own body unchanged (Eq. 3.2 at β = β^g).
+
+use glam::Vec3;
+use mannequin_body::BodyModel;
+use mannequin_garment::{Category, Dressed, Fit, make_garment};
+use mannequin_mesh::adjacency::{boundary_loops, edges};
+use mannequin_mesh::{ClosestPoint, TriMesh};
+
+/// Each edge in at most two faces, and each vertex's faces one fan (no bow-ties).
+fn assert_manifold(name: &str, mesh: &TriMesh) {
+    let mut count = std::collections::HashMap::new();
+    for t in &mesh.faces {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    assert!(count.values().all(|&n| n <= 2), "{name}: an edge in more than two faces");
+    // A bow-tie vertex sits on two boundary loops, or twice on one.
+    let mut seen = std::collections::HashSet::new();
+    for l in boundary_loops(&mesh.faces) {
+        for v in l {
+            assert!(seen.insert(v), "{name}: vertex {v} is on the boundary twice (a bow-tie)");
+        }
+    }
+}
+
+#[test]
+fn every_category_is_a_clean_eased_manifold_that_transfers_to_its_own_body() {
+    let model = BodyModel::default_body();
+    let body = model.template_mesh();
+    let index = ClosestPoint::new(&body.positions, &body.faces, 0.03);
+    let fit = Fit::size("M").unwrap();
+    for (category, openings) in
+        [(Category::Pants, 3), (Category::ShortPants, 3), (Category::Tshirt, 4), (Category::Shirt, 4)]
+    {
+        let name = category.name();
+        let target = 0.015;
+        let g =
+            make_garment(category, fit, target, category.default_material(), &model, "default", &[]).unwrap();
+        assert_manifold(name, &g.mesh);
+        let loops: Vec<usize> = boundary_loops(&g.mesh.faces).iter().map(Vec::len).collect();
+        assert_eq!(loops.len(), openings, "{name}: openings of {loops:?} vertices");
+
+        let lengths: Vec<f32> = edges(&g.mesh.faces)
+            .iter()
+            .map(|&[a, b]| {
+                Vec3::from(g.mesh.positions[a as usize]).distance(Vec3::from(g.mesh.positions[b as usize]))
+            })
+            .collect();
+        let mean = lengths.iter().sum::<f32>() / lengths.len() as f32;
+        let sd = (lengths.iter().map(|l| (l - mean).powi(2)).sum::<f32>() / lengths.len() as f32).sqrt();
+        assert!((mean - target).abs() < 0.15 * target, "{name}: mean edge {mean}");
+        assert!(sd / mean < 0.3, "{name}: edge CV {}", sd / mean);
+
+        // Every vertex stands off the body by about the ease (between 0.5 and 1.5 × the least
+        // and most of the fit's three values), measured against the body mesh directly.
+        let (lo, hi) =
+            (fit.ease_waist.min(fit.ease_hips).min(fit.ease_chest), fit.ease_chest.max(fit.ease_waist));
+        let off = g.mesh.positions.iter().filter(|&&p| {
+            let d = index.query(Vec3::from(p)).unwrap().1.distance(Vec3::from(p));
+            !(0.5 * lo..=1.5 * hi).contains(&d)
+        });
+        let off = off.count();
+        assert!(
+            off * 100 < g.vertex_count(),
+            "{name}: {off} of {} vertices off the eased surface",
+            g.vertex_count()
+        );
+        assert!(g.mesh.uv.as_ref().is_some_and(|uv| uv.faces.len() == g.mesh.faces.len()), "{name}: UVs");
+
+        // Eq. 3.2 on the template's own body gives the template back.
+        let dressed = Dressed::new(&g, &model, &[]).unwrap();
+        let worst = dressed
+            .rest()
+            .iter()
+            .zip(&g.mesh.positions)
+            .map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b)))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-5, "{name}: {worst} m from the template");
+    }
+}
