@@ -45,7 +45,7 @@ pub fn run(args: Args) -> Result<()> {
 
 /// `render`'s front camera on the centre of the clip's bounding box `lo`–`hi`, moved back until
 /// the whole box fits, so the view stays fixed while the body moves through it.
-fn clip_camera(lo: [f32; 3], hi: [f32; 3]) -> Camera {
+pub fn clip_camera(lo: [f32; 3], hi: [f32; 3]) -> Camera {
     /// Room around the box, as a fraction of its half-size.
     const MARGIN: f64 = 1.1;
     let centre = box_centre(&[lo, hi]);
@@ -101,15 +101,14 @@ fn animate_avatar(args: &Args, motion: &Motion) -> Result<()> {
         camera.height,
         args.output.display()
     );
-    write_video(&args.output, frames, motion.fps)
+    write_video(&args.output, &args.output.join("animation.mp4"), frames, motion.fps)
 }
 
-/// Encodes the frames as `animation.mp4` (H.264, yuv420p: what players accept) where ffmpeg is
+/// Encodes `dir/frame_%04d.png` as `video` (H.264, yuv420p: what players accept) where ffmpeg is
 /// installed, writing to a temporary name and renaming so a failed run leaves no partial video.
 /// Only the `frames` frames of this run are read, not stale ones from a longer earlier run.
-fn write_video(dir: &Path, frames: usize, fps: f32) -> Result<()> {
-    let video = dir.join("animation.mp4");
-    let partial = dir.join(".animation.mp4.partial");
+pub fn write_video(dir: &Path, video: &Path, frames: usize, fps: f32) -> Result<()> {
+    let partial = video.with_extension("mp4.partial");
     let result = Command::new("ffmpeg")
         .args(["-y", "-loglevel", "error", "-framerate", &fps.to_string(), "-i"])
         .arg(dir.join("frame_%04d.png"))
@@ -134,7 +133,7 @@ fn write_video(dir: &Path, frames: usize, fps: f32) -> Result<()> {
         let stderr = String::from_utf8_lossy(&output.stderr);
         bail!("{}: ffmpeg failed: {}", video.display(), stderr.lines().last().unwrap_or("no message").trim());
     }
-    std::fs::rename(&partial, &video).with_context(|| format!("writing {}", video.display()))?;
+    std::fs::rename(&partial, video).with_context(|| format!("writing {}", video.display()))?;
     tracing::info!("wrote {} ({fps} fps)", video.display());
     Ok(())
 }

@@ -6,8 +6,10 @@ mod body;
 mod cloth;
 mod compute;
 mod demo;
+mod dress;
 mod eval;
 mod export;
+mod garment;
 mod motion;
 mod pose_choice;
 mod progress;
@@ -36,6 +38,12 @@ enum Command {
     /// Simulate a garment on a moving body (XPBD cloth).
     #[command(subcommand)]
     Cloth(cloth::ClothCommand),
+    /// Make garment templates (.garment) cut from a body's surface, or summarise one.
+    #[command(subcommand)]
+    Garment(garment::GarmentCommand),
+    /// Dress a body of any shape in garments and play a motion: skinned transfer (MGN) and cloth
+    /// simulation, as a glTF scene, point caches, rendered frames and metrics.
+    Dress(dress::Args),
     /// Write motion files (a procedural walk as AMASS .npz).
     #[command(subcommand)]
     Motion(motion::MotionCommand),
@@ -65,6 +73,8 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
     match command {
         Command::Body(cmd) => body::run(cmd),
         Command::Cloth(cmd) => cloth::run(cmd),
+        Command::Garment(cmd) => garment::run(cmd),
+        Command::Dress(args) => dress::run(args),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
         Command::Demo(args) => demo::run(args),

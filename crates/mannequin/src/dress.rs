@@ -1,0 +1,477 @@
+//! `mannequin dress`: put garments on a body of any shape (thesis Eqs. 3.1–3.3) and play a
+//! motion, the cloth simulator resolving what skinning cannot (gravity on loose parts, the body
+//! pushing through after a shape change). Layers are simulated inner first; each one collides
+//! with the body and with every layer under it.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args as ClapArgs;
+use mannequin_body::{BodyModel, Settling, pose_frames, shape_body, skeletal_animation, skinned_body};
+use mannequin_cloth::{Attachment, Body, Cloth, Material, Settings, Simulator, quality};
+use mannequin_garment::file::{read_garment, write_garment};
+use mannequin_garment::{Category, Dressed, Fit, Garment, SIZE_NAMES, make_garment};
+use mannequin_mesh::{MorphSequence, PointCache, TriMesh, write_scene_glb};
+use serde::Serialize;
+
+use crate::body::{BodyArgs, load_body};
+use crate::motion::Clip;
+use crate::progress::{JobTimer, bar};
+
+mod fit_report;
+mod frames;
+
+#[derive(ClapArgs)]
+#[command(after_help = "Writes OUT/dressed.glb (the skinned body and every garment as morph targets), \
+OUT/<garment>.pc2, OUT/frames/frame_0000.png, ... (and OUT/frames.mp4 with ffmpeg) and OUT/metrics.json.")]
+pub struct Args {
+    #[command(flatten)]
+    body: BodyArgs,
+    /// Garments, inner layer first: .garment files (`mannequin garment make`), or category names
+    /// (pants, short-pants, shirt, tshirt), made at --size on this body and cached.
+    #[arg(long, value_delimiter = ',', required = true)]
+    garments: Vec<String>,
+    /// The size of garments given by category name.
+    #[arg(long, default_value = "M", value_parser = clap::builder::PossibleValuesParser::new(SIZE_NAMES))]
+    size: String,
+    #[command(flatten)]
+    clip: Clip,
+    /// Camera JSON (K, extrinsic, width, height) for the frames; default: a front view framing the clip.
+    #[arg(long)]
+    camera: Option<PathBuf>,
+    /// Simulation substeps per frame.
+    #[arg(long, default_value_t = 20)]
+    substeps: u32,
+    /// Seconds before the motion: half at rest, half blending into its first frame.
+    #[arg(long, default_value_t = 1.0)]
+    settle: f32,
+    /// Skin the garments only (Eqs. 3.2–3.3), without the cloth simulator.
+    #[arg(long)]
+    no_simulation: bool,
+    /// Cloth–cloth contacts within each garment (vertex–triangle and edge–edge); slow, see
+    /// `cloth simulate --self-collision`.
+    #[arg(long)]
+    self_collision: bool,
+    /// Skip the rendered frames.
+    #[arg(long)]
+    no_frames: bool,
+    /// Print, per garment and body region, how far it stands off the body and where it is
+    /// stretched past its material's limit, on the body settled in the motion's first pose.
+    #[arg(long)]
+    fit_report: bool,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// How far (m) each layer stands beyond the one under it at rest: twice the simulator's body
+/// margin, so the outer layer starts clear of the inner one's collision shell.
+const LAYER_GAP: f32 = 0.01;
+
+/// A layer under the one being simulated: its triangles, and its positions at every frame of
+/// the schedule.
+type Layer<'a> = (&'a [[u32; 3]], &'a [Vec<[f32; 3]>]);
+
+/// One garment being worn: its name in the outputs, template and transfer to this body.
+struct Worn<'a> {
+    name: String,
+    garment: &'a Garment,
+    dressed: Dressed<'a>,
+}
+
+/// Per garment and motion frame, what went wrong where.
+#[derive(Debug, Clone, Serialize)]
+struct FrameMetrics {
+    frame: usize,
+    vertices_inside_body: usize,
+    /// Triangle pairs crossing the layers under this one.
+    crossings_with_inner_layers: usize,
+    max_edge_strain: f32,
+    mean_edge_strain: f32,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let _timer = JobTimer::start("dress");
+    let mut stage_s = serde_json::Map::new();
+    let mut stage = |name: &str, start: Instant| {
+        stage_s.insert(name.to_string(), start.elapsed().as_secs_f64().into());
+    };
+    let start = Instant::now();
+    let model = load_body(&args.body.body)?;
+    let motion = args.clip.load()?;
+    let betas = &args.body.betas;
+    let loaded: Vec<(String, Garment)> = args
+        .garments
+        .iter()
+        .map(|g| load_or_make(g, &model, &args.body.body, &args.size))
+        .collect::<Result<_>>()?;
+    // Each layer stands clear of those under it (in rest space, so on every body shape).
+    let body_faces = model.template_mesh().faces;
+    let templates: Vec<(String, Garment)> = loaded
+        .iter()
+        .enumerate()
+        .map(|(i, (name, g))| {
+            let inner: Vec<&Garment> = loaded[..i].iter().map(|(_, g)| g).collect();
+            (name.clone(), g.over(&inner, LAYER_GAP, &body_faces))
+        })
+        .collect();
+    let worn: Vec<Worn> = templates
+        .iter()
+        .enumerate()
+        .map(|(i, (name, garment))| {
+            let dressed = Dressed::new(garment, &model, betas).with_context(|| format!("dressing {name}"))?;
+            let name = if templates[..i].iter().any(|(n, _)| n == name) {
+                format!("{name}_{i}")
+            } else {
+                name.clone()
+            };
+            Ok(Worn { name, garment, dressed })
+        })
+        .collect::<Result<_>>()?;
+    stage("transfer", start);
+
+    let start = Instant::now();
+    let schedule = Settling::new(&model, &motion, args.settle)?;
+    let shaped = shape_body(&model, betas)?;
+    let body_frames: Vec<Vec<[f32; 3]>> = (0..schedule.len())
+        .map(|k| {
+            let (pose, trans) = schedule.pose(k);
+            Ok(points(pose_frames(&model, &shaped, pose, trans)?.frame_vertices(0)))
+        })
+        .collect::<Result<_>>()?;
+    stage("body", start);
+
+    let start = Instant::now();
+    let mut layers: Vec<Vec<Vec<[f32; 3]>>> = Vec::new();
+    for w in &worn {
+        let frames = if args.no_simulation {
+            (0..schedule.len())
+                .map(|k| {
+                    let (pose, trans) = schedule.pose(k);
+                    Ok(w.dressed.posed(pose, trans)?)
+                })
+                .collect::<Result<_>>()?
+        } else {
+            let inner: Vec<Layer> = worn
+                .iter()
+                .zip(&layers)
+                .map(|(v, f)| (v.garment.mesh.faces.as_slice(), f.as_slice()))
+                .collect();
+            simulate_layer(w, &inner, &body_frames, &body_faces, &args, motion.fps, schedule.settle)?
+        };
+        layers.push(frames);
+    }
+    stage("simulation", start);
+
+    if args.fit_report {
+        let k = schedule.settle - 1;
+        for (i, w) in worn.iter().enumerate() {
+            let limit = Material::named(&w.garment.recipe.material)?.strain_limit;
+            let report = fit_report::fit_report(
+                &layers[i][k],
+                &w.dressed.rest(),
+                &w.garment.mesh.faces,
+                &w.dressed.weights,
+                model.num_joints(),
+                &body_frames[k],
+                &body_faces,
+                limit,
+            );
+            println!("{} ({}):", w.name, w.garment.recipe.material);
+            println!(
+                "  {:<16} {:>8} {:>10} {:>11} {:>10}  verdict",
+                "region", "vertices", "min ease", "mean ease", "strain"
+            );
+            for r in report {
+                println!(
+                    "  {:<16} {:>8} {:>7.1} cm {:>8.1} cm {:>9.1} %  {}",
+                    r.region,
+                    r.vertices,
+                    r.min_ease_cm,
+                    r.mean_ease_cm,
+                    100.0 * r.max_strain,
+                    r.verdict
+                );
+            }
+        }
+    }
+
+    // From here on, only the motion's frames.
+    let motion_frames = schedule.settle..schedule.len();
+    let start = Instant::now();
+    let metrics: Vec<Vec<FrameMetrics>> = worn
+        .iter()
+        .enumerate()
+        .map(|(i, w)| {
+            let rest = w.dressed.rest();
+            motion_frames
+                .clone()
+                .map(|k| {
+                    let positions = &layers[i][k];
+                    let (max_edge_strain, mean_edge_strain) =
+                        quality::edge_strain(&rest, positions, &w.garment.mesh.faces);
+                    let crossings_with_inner_layers = (0..i)
+                        .map(|j| {
+                            crossings(
+                                positions,
+                                &w.garment.mesh.faces,
+                                &layers[j][k],
+                                &worn[j].garment.mesh.faces,
+                            )
+                        })
+                        .sum();
+                    FrameMetrics {
+                        frame: k - schedule.settle,
+                        vertices_inside_body: quality::vertices_inside_body(
+                            positions,
+                            &body_frames[k],
+                            &body_faces,
+                        ),
+                        crossings_with_inner_layers,
+                        max_edge_strain,
+                        mean_edge_strain,
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    stage("metrics", start);
+
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let start = Instant::now();
+    if !args.no_frames {
+        let meshes: Vec<(&[[u32; 3]], [f32; 3])> = worn
+            .iter()
+            .map(|w| (w.garment.mesh.faces.as_slice(), w.garment.recipe.category.colour()))
+            .collect();
+        let scene = frames::Scene { body_faces: &body_faces, garments: &meshes };
+        let garment_frames: Vec<Vec<&[[f32; 3]]>> =
+            motion_frames.clone().map(|k| layers.iter().map(|l| l[k].as_slice()).collect()).collect();
+        let body_motion: Vec<&[[f32; 3]]> =
+            motion_frames.clone().map(|k| body_frames[k].as_slice()).collect();
+        frames::render(&scene, &body_motion, &garment_frames, args.camera.as_deref(), &args.out, motion.fps)?;
+    }
+    stage("render", start);
+
+    let start = Instant::now();
+    let motion_layers: Vec<Vec<Vec<[f32; 3]>>> =
+        layers.iter().map(|l| l[motion_frames.clone()].to_vec()).collect();
+    write_scene(&args.out, &model, betas, &motion, &worn, &motion_layers)?;
+    stage("write", start);
+    write_metrics(&args.out, &worn, &metrics, motion.fps, stage_s)
+}
+
+/// A `.garment` file, or a category name made at `size` on this body and cached under
+/// `$XDG_CACHE_HOME/mannequin/garments` (or `~/.cache/...`), keyed by everything that made it.
+fn load_or_make(spec: &str, model: &BodyModel, body: &str, size: &str) -> Result<(String, Garment)> {
+    let Ok(category) = Category::named(spec) else {
+        let path = Path::new(spec);
+        if !path.exists() {
+            bail!(
+                "--garments: {spec:?} is neither a .garment file nor a category ({})",
+                mannequin_garment::CATEGORY_NAMES.join(", ")
+            );
+        }
+        let garment = read_garment(path)?;
+        let name = path.file_stem().map_or_else(|| "garment".into(), |s| s.to_string_lossy().into_owned());
+        return Ok((name, garment));
+    };
+    let body_key = if Path::new(body).exists() {
+        mannequin_data::fingerprint::hash_bytes(
+            &std::fs::read(body).with_context(|| format!("reading {body}"))?,
+        )
+    } else {
+        body.to_string()
+    };
+    let key = format!("{}-{size}-{body_key}-v{}", category.name(), env!("CARGO_PKG_VERSION"));
+    let cache = cache_dir().map(|d| d.join("garments").join(format!("{key}.garment")));
+    if let Some(path) = &cache
+        && path.exists()
+        && let Ok(garment) = read_garment(path)
+    {
+        tracing::info!("{}: from the cache, {}", category.name(), path.display());
+        return Ok((category.name().to_string(), garment));
+    }
+    let start = Instant::now();
+    let garment =
+        make_garment(category, Fit::size(size)?, 0.015, category.default_material(), model, body, &[])?;
+    tracing::info!("{}: made in {:.1} s", category.name(), start.elapsed().as_secs_f64());
+    if let Some(path) = &cache {
+        let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(anyhow::Error::from);
+        if let Err(e) = written.and_then(|()| Ok(write_garment(path, &garment)?)) {
+            tracing::warn!("not cached: {}: {e:#}", path.display());
+        }
+    }
+    Ok((category.name().to_string(), garment))
+}
+
+fn cache_dir() -> Option<PathBuf> {
+    std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .map(|d| d.join("mannequin"))
+}
+
+/// One layer through the whole schedule (settling included), colliding with the body and the
+/// layers under it; lower-body garments are held at the waist (the loop of their boundary
+/// that is highest at rest), as an elastic waistband holds them.
+fn simulate_layer(
+    worn: &Worn,
+    inner: &[Layer],
+    body_frames: &[Vec<[f32; 3]>],
+    body_faces: &[[u32; 3]],
+    args: &Args,
+    fps: f32,
+    settle: usize,
+) -> Result<Vec<Vec<[f32; 3]>>> {
+    let garment = worn.garment;
+    let rest = worn.dressed.rest();
+    let mut mesh = garment.mesh.clone();
+    mesh.positions = rest.clone();
+    let material = Material::named(&garment.recipe.material)?;
+    let cloth = Cloth::new(&mesh, &material, &[]).with_context(|| worn.name.clone())?;
+
+    let mut faces = body_faces.to_vec();
+    let mut offset = body_frames[0].len() as u32;
+    for (f, frames) in inner {
+        faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
+        offset += frames[0].len() as u32;
+    }
+    let collider = |k: usize| -> Vec<[f32; 3]> {
+        let mut all = body_frames[k].clone();
+        for (_, frames) in inner {
+            all.extend_from_slice(&frames[k]);
+        }
+        all
+    };
+    let at_rest = collider(0);
+    let attachments: Vec<Attachment> = if garment.recipe.category.is_lower_body() {
+        waist_loop(&mesh)
+            .into_iter()
+            .map(|v| Attachment::bind(&at_rest, &faces, v, mesh.positions[v as usize]))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let settings =
+        Settings { substeps: args.substeps, self_collision: args.self_collision, ..Settings::default() };
+    let mut sim = Simulator::new(cloth, Some(Body::new(faces)), attachments, settings)?;
+    let dt = 1.0 / fps;
+    let progress = bar(body_frames.len() as u64, &worn.name);
+    let mut frames = vec![rest];
+    let mut previous = at_rest;
+    for k in 1..body_frames.len() {
+        let next = collider(k);
+        sim.step_frame(&previous, &next, dt).with_context(|| {
+            let when =
+                if k < settle { "while settling".into() } else { format!("at motion frame {}", k - settle) };
+            format!("{} {when}", worn.name)
+        })?;
+        frames.push(sim.positions().to_vec());
+        previous = next;
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    Ok(frames)
+}
+
+/// The vertices of the boundary loop whose mean height at rest is greatest.
+fn waist_loop(mesh: &TriMesh) -> Vec<u32> {
+    let height =
+        |l: &Vec<u32>| l.iter().map(|&v| mesh.positions[v as usize][1]).sum::<f32>() / l.len() as f32;
+    mannequin_mesh::adjacency::boundary_loops(&mesh.faces)
+        .into_iter()
+        .max_by(|a, b| height(a).total_cmp(&height(b)))
+        .unwrap_or_default()
+}
+
+/// Triangle pairs of two meshes that cross: the pairs of their union less each one's own.
+fn crossings(a: &[[f32; 3]], a_faces: &[[u32; 3]], b: &[[f32; 3]], b_faces: &[[u32; 3]]) -> usize {
+    let mut positions = a.to_vec();
+    positions.extend_from_slice(b);
+    let n = a.len() as u32;
+    let mut faces = a_faces.to_vec();
+    faces.extend(b_faces.iter().map(|t| t.map(|i| i + n)));
+    let union = quality::self_intersecting_pairs(&positions, &faces);
+    union - quality::self_intersecting_pairs(a, a_faces) - quality::self_intersecting_pairs(b, b_faces)
+}
+
+/// dressed.glb (the skinned body playing the motion, each garment as morph targets in sync)
+/// and one Blender point cache per garment.
+fn write_scene(
+    dir: &Path,
+    model: &BodyModel,
+    betas: &[f32],
+    motion: &mannequin_body::Motion,
+    worn: &[Worn],
+    layers: &[Vec<Vec<[f32; 3]>>],
+) -> Result<()> {
+    let f = motion.num_frames();
+    let mut morphs = Vec::new();
+    for (w, frames) in worn.iter().zip(layers) {
+        PointCache { start: 0.0, sampling: 1.0, frames: frames.clone() }
+            .write(&dir.join(format!("{}.pc2", w.name)))?;
+        let mut mesh = w.garment.mesh.clone();
+        mesh.positions = frames[0].clone();
+        mesh.colors = Some(vec![w.garment.recipe.category.colour(); mesh.vertex_count()]);
+        morphs.push(MorphSequence { name: w.name.clone(), mesh, frames: frames.clone(), fps: motion.fps });
+    }
+    let skinned = skinned_body(model, betas)?;
+    let poses = motion.poses_for(model)?;
+    let pl = model.pose_len();
+    let animation = skeletal_animation(model, &poses[..f * pl], &motion.trans[..3 * f], motion.fps)?;
+    write_scene_glb(dir.join("dressed.glb"), &skinned, Some(&animation), &morphs)?;
+    Ok(())
+}
+
+fn write_metrics(
+    dir: &Path,
+    worn: &[Worn],
+    metrics: &[Vec<FrameMetrics>],
+    fps: f32,
+    stage_s: serde_json::Map<String, serde_json::Value>,
+) -> Result<()> {
+    let garments: Vec<serde_json::Value> = worn
+        .iter()
+        .zip(metrics)
+        .map(|(w, m)| {
+            serde_json::json!({
+                "name": w.name,
+                "category": w.garment.recipe.category.name(),
+                "material": w.garment.recipe.material,
+                "strain_limit": Material::named(&w.garment.recipe.material).map_or(f32::NAN, |m| m.strain_limit),
+                "vertices": w.garment.vertex_count(),
+                "max_vertices_inside_body": m.iter().map(|x| x.vertices_inside_body).max(),
+                "max_crossings_with_inner_layers": m.iter().map(|x| x.crossings_with_inner_layers).max(),
+                "max_edge_strain": m.iter().map(|x| x.max_edge_strain).fold(0.0f32, f32::max),
+                "mean_edge_strain": m.iter().map(|x| x.mean_edge_strain).sum::<f32>() / m.len().max(1) as f32,
+                "per_frame": m,
+            })
+        })
+        .collect();
+    let summary = serde_json::json!({
+        "frames": metrics.first().map_or(0, Vec::len),
+        "fps": fps,
+        "stage_s": stage_s,
+        "garments": garments,
+    });
+    let path = dir.join("metrics.json");
+    mannequin_io::write_atomic(&path, serde_json::to_string_pretty(&summary)?.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    for g in summary["garments"].as_array().into_iter().flatten() {
+        tracing::info!(
+            "{}: at most {} vertices inside the body, {} crossings with inner layers; strain max {:.3}",
+            g["name"],
+            g["max_vertices_inside_body"],
+            g["max_crossings_with_inner_layers"],
+            g["max_edge_strain"].as_f64().unwrap_or(0.0)
+        );
+    }
+    tracing::info!("stages (s): {}", summary["stage_s"]);
+    Ok(())
+}
+
+fn points(flat: &[f32]) -> Vec<[f32; 3]> {
+    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
+}

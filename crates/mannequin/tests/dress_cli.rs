@@ -1,0 +1,104 @@
+//! `mannequin garment make` and `mannequin dress` as a user runs them: templates made and read
+//! back, then pants under a T-shirt on five body shapes (±2 on the first two betas) through a
+//! short walk, checked by what the run measured and by readers of the outputs' own formats.
+
+use std::path::Path;
+
+mod common;
+use common::{mannequin, ok, one_line_error, s, scratch};
+use mannequin_mesh::PointCache;
+
+#[path = "../../../tools/node_checks.rs"]
+mod node_checks;
+use node_checks::KHRONOS_VALIDATOR;
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+#[test]
+fn a_made_template_reads_back() {
+    let dir = scratch("garment_make");
+    let file = dir.join("tshirt.garment");
+    let out = ok(mannequin(&[
+        "garment",
+        "make",
+        "--category",
+        "tshirt",
+        "--size",
+        "L",
+        "--sleeve",
+        "0.5",
+        "--out",
+        s(&file),
+        "--obj",
+        s(&dir.join("tshirt.obj")),
+    ]));
+    let made: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(made["boundary_loops"], 4, "{made}");
+    let info: serde_json::Value =
+        serde_json::from_slice(&ok(mannequin(&["garment", "info", s(&file), "--json"])).stdout).unwrap();
+    assert_eq!(info["vertices"], made["vertices"]);
+    assert_eq!(info["fit"]["sleeve"], 0.5);
+    let obj = mannequin_mesh::read_obj(dir.join("tshirt.obj")).unwrap();
+    assert_eq!(obj.vertex_count() as u64, made["vertices"].as_u64().unwrap());
+
+    // A template made on one body model is refused on another, naming the fix.
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "-o", s(&walk), "--seconds", "0.2"]));
+    let lod1 = dir.join("lod1.garment");
+    ok(mannequin(&["garment", "make", "--category", "pants", "--body", "default-lod1", "--out", s(&lod1)]));
+    let o = mannequin(&["dress", "--garments", s(&lod1), "--motion", s(&walk), "--out", s(&dir.join("x"))]);
+    one_line_error(&o, &["lod1", "make it again on this body"]);
+    let o = mannequin(&["dress", "--garments", "tunic", "--motion", s(&walk), "--out", s(&dir.join("x"))]);
+    one_line_error(&o, &["tunic", "pants, short-pants, shirt, tshirt"]);
+}
+
+#[test]
+fn pants_and_a_tshirt_walk_on_five_body_shapes() {
+    let dir = scratch("dress_shapes");
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "-o", s(&walk), "--seconds", "1"]));
+    let cache = dir.join("cache");
+    for (i, betas) in ["0,0", "2,0", "-2,0", "0,2", "0,-2"].iter().enumerate() {
+        let out = dir.join(format!("shape_{i}"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"))
+            .args([
+                "dress",
+                "--garments",
+                "pants,tshirt",
+                "--betas",
+                betas,
+                "--motion",
+                s(&walk),
+                "--out",
+                s(&out),
+            ])
+            .args(if i == 0 { &[][..] } else { &["--no-frames"][..] })
+            .env("XDG_CACHE_HOME", &cache)
+            .output()
+            .unwrap();
+        ok(o);
+        let metrics = read_json(&out.join("metrics.json"));
+        assert_eq!(metrics["frames"], 30);
+        for g in metrics["garments"].as_array().unwrap() {
+            let name = g["name"].as_str().unwrap();
+            assert_eq!(
+                g["max_vertices_inside_body"], 0,
+                "betas {betas}, {name}: {}",
+                g["max_vertices_inside_body"]
+            );
+            let (strain, limit) =
+                (g["max_edge_strain"].as_f64().unwrap(), g["strain_limit"].as_f64().unwrap());
+            assert!(strain <= limit, "betas {betas}, {name}: strain {strain} past the material's {limit}");
+            let cache = PointCache::read(&out.join(format!("{name}.pc2"))).unwrap();
+            assert_eq!(cache.frames.len(), 30);
+            assert_eq!(cache.frames[0].len() as u64, g["vertices"].as_u64().unwrap());
+        }
+        if i == 0 {
+            assert!(out.join("frames/frame_0029.png").exists());
+            // Fails the test on any validator error.
+            KHRONOS_VALIDATOR.run(&out.join("dressed.glb"));
+        }
+    }
+}
