@@ -20,6 +20,7 @@ mod settings;
 mod simulator;
 mod state;
 mod stretch;
+mod tethers;
 mod topology;
 
 pub use attachment::Attachment;

@@ -16,6 +16,7 @@ use crate::phase_times::PhaseTimes;
 use crate::self_contacts::SelfContacts;
 use crate::settings::Settings;
 use crate::state::ClothState;
+use crate::tethers::Tethers;
 
 pub struct Simulator {
     cloth: Cloth,
@@ -24,6 +25,8 @@ pub struct Simulator {
     inverse_mass: Vec<f32>,
     body: Option<BodyCollider>,
     attachments: Vec<Attachment>,
+    /// Long-range attachments to the attached particles (none without attachments).
+    tethers: Tethers,
     /// Present when self-collision is on.
     contacts: Option<SelfContacts>,
     positions: Vec<[f32; 3]>,
@@ -51,7 +54,14 @@ impl Simulator {
         for a in &attachments {
             inverse_mass[a.particle as usize] = 0.0;
         }
+        let anchors: Vec<u32> = attachments.iter().map(|a| a.particle).collect();
+        let tethers = if anchors.is_empty() {
+            Tethers::default()
+        } else {
+            Tethers::new(&cloth.rest, &cloth.edges(), &anchors)
+        };
         Ok(Self {
+            tethers,
             inverse_mass,
             body: body.map(BodyCollider::new),
             attachments,
@@ -131,6 +141,7 @@ impl Simulator {
         for _ in 0..self.settings.iterations {
             let t = Instant::now();
             self.cloth.stretch.project(&mut self.positions, w, &mut self.stretch_lambda, dt);
+            self.tethers.project(&mut self.positions, w);
             self.times.stretch += t.elapsed();
             let t = Instant::now();
             self.cloth.bending.project(&mut self.positions, w, &mut self.bending_lambda, dt);

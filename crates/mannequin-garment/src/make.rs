@@ -48,15 +48,18 @@ pub fn make_garment(
             format!("the {} cuts leave nothing of the body: check hem_height and sleeve", category.name()),
         ));
     }
-    // Remesh on the eased surface itself (each point's closest body point, pushed out along the
-    // body's normal there by the ease at its height), not on the body: in a hollow (the crotch,
+    // Remesh on the eased surface itself (each point moved along the body's normal at its
+    // closest body point to the ease at that height), not on the body: in a hollow (the crotch,
     // the small of the back) offsetting after remeshing would bunch the vertices together.
     let surface = ClosestPoint::new(&rest, &body.faces, 0.03);
     let body_normals: Vec<f32> = vertex_normals(&rest, &body.faces).into_iter().flatten().collect();
     let onto_eased = |p: Vec3| {
         let Some((point, q)) = surface.query(p) else { return p };
         let n = Vec3::from_slice(&point.interpolate(&body.faces, &body_normals, 3)).normalize_or_zero();
-        q + n * marks.ease_at(&fit, q.y)
+        // Along the normal only, keeping p's place across it: every point near a convex body
+        // vertex has that vertex as its closest point, and mapping them all to one point would
+        // collapse their triangles.
+        p - n * ((p - q).dot(n) - marks.ease_at(&fit, q.y))
     };
     let start: Vec<[f32; 3]> =
         region.positions.iter().map(|&p| onto_eased(Vec3::from(p)).to_array()).collect();

@@ -31,15 +31,27 @@ fn every_category_is_a_clean_eased_manifold_that_transfers_to_its_own_body() {
     let model = BodyModel::default_body();
     let body = model.template_mesh();
     let index = ClosestPoint::new(&body.positions, &body.faces, 0.03);
-    let fit = Fit::size("M").unwrap();
-    for (category, openings) in
-        [(Category::Pants, 3), (Category::ShortPants, 3), (Category::Tshirt, 4), (Category::Shirt, 4)]
-    {
-        let name = category.name();
+    for (category, openings, size) in [
+        (Category::Pants, 3, "M"),
+        (Category::ShortPants, 3, "XL"),
+        (Category::Tshirt, 4, "XL"),
+        (Category::Shirt, 4, "S"),
+    ] {
+        let fit = Fit::size(size).unwrap();
+        let name = format!("{} {size}", category.name());
+        let name = name.as_str();
         let target = 0.015;
         let g =
             make_garment(category, fit, target, category.default_material(), &model, "default", &[]).unwrap();
         assert_manifold(name, &g.mesh);
+        let smallest = mannequin_mesh::double_areas(&g.mesh.positions, &g.mesh.faces)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        // A third of an equilateral triangle's area at the target length, at least.
+        assert!(
+            smallest > 0.3 * 3f64.sqrt() / 2.0 * (target as f64).powi(2) / 3.0,
+            "{name}: a {smallest} m² sliver"
+        );
         let loops: Vec<usize> = boundary_loops(&g.mesh.faces).iter().map(Vec::len).collect();
         assert_eq!(loops.len(), openings, "{name}: openings of {loops:?} vertices");
 

@@ -10,7 +10,7 @@ mod strain;
 mod triangle_intersection;
 
 pub use self_intersection::self_intersecting_pairs;
-pub use strain::edge_strain;
+pub use strain::{edge_strain, stretch_quantile};
 
 /// How many cloth vertices lie inside the closed body mesh (`body_positions`, `body_faces`).
 pub fn vertices_inside_body(

@@ -23,6 +23,28 @@ pub fn edge_strain(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]]) 
     (max as f32, (strains.iter().sum::<f64>() / strains.len() as f64) as f32)
 }
 
+/// The `q` quantile (0–1) of the edges' stretch max(l/l₀ − 1, 0): how far the most stretched
+/// edges are past their rest length, ignoring compression (cloth buckles rather than resists it).
+pub fn stretch_quantile(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]], q: f64) -> f32 {
+    let mut stretch: Vec<f64> = mannequin_mesh::adjacency::edges(faces)
+        .iter()
+        .filter_map(|&[a, b]| {
+            let length = |p: &[[f32; 3]]| -> Option<f64> {
+                let (a, b) = (p.get(a as usize)?, p.get(b as usize)?);
+                Some((0..3).map(|k| (a[k] as f64 - b[k] as f64).powi(2)).sum::<f64>().sqrt())
+            };
+            let (l0, l) = (length(rest)?, length(current)?);
+            (l0 > 0.0).then(|| (l / l0 - 1.0).max(0.0))
+        })
+        .collect();
+    if stretch.is_empty() {
+        return 0.0;
+    }
+    stretch.sort_by(f64::total_cmp);
+    let at = ((q.clamp(0.0, 1.0) * (stretch.len() - 1) as f64).round()) as usize;
+    stretch[at] as f32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -35,5 +57,12 @@ mod tests {
         let hypotenuse = (1.5f32.hypot(1.0) / 2f32.sqrt()) - 1.0;
         assert!((max - 0.5).abs() < 1e-6);
         assert!((mean - (0.5 + hypotenuse) / 3.0).abs() < 1e-6);
+        // Stretches sorted: 0 (the unchanged leg), the hypotenuse's, 0.5.
+        assert_eq!(stretch_quantile(&rest, &stretched, &[[0, 1, 2]], 0.0), 0.0);
+        assert!((stretch_quantile(&rest, &stretched, &[[0, 1, 2]], 0.5) - hypotenuse).abs() < 1e-6);
+        assert!((stretch_quantile(&rest, &stretched, &[[0, 1, 2]], 1.0) - 0.5).abs() < 1e-6);
+        // Compression is not stretch.
+        let squeezed = [[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert_eq!(stretch_quantile(&rest, &squeezed, &[[0, 1, 2]], 1.0), 0.0);
     }
 }
