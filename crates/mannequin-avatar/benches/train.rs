@@ -39,7 +39,7 @@ use mannequin_data::Dataset;
 use mannequin_data::Scores;
 use mannequin_data::evaluation::EvalOptions;
 use mannequin_data::rng::SplitMix64;
-use mannequin_data::synth::{SynthOptions, generate};
+use mannequin_synth::{SynthOptions, generate};
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3

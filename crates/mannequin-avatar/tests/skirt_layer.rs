@@ -10,10 +10,10 @@ use mannequin_avatar::skirt_layer::{SkirtMode, fit_skirt};
 use mannequin_avatar::{Avatar, AvatarConfig, Canonical, Method, View, load_views};
 use mannequin_body::BodyModel;
 use mannequin_data::metrics::surface_distance::TriangleBvh;
-use mannequin_data::synth::skirt::skirt_span;
-use mannequin_data::synth::subject::Outfit;
-use mannequin_data::synth::{SynthOptions, generate};
 use mannequin_data::{Dataset, Split};
+use mannequin_synth::skirt::skirt_span;
+use mannequin_synth::subject::Outfit;
+use mannequin_synth::{SynthOptions, generate};
 
 /// A small subject: 256 px keeps a pixel near 8 mm, the carving's resolution.
 fn subject(seed: u64, expected: Outfit) -> (PathBuf, Dataset, Split, Vec<View>) {

@@ -10,8 +10,8 @@ use mannequin_avatar::{
     load_views,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::synth::{SynthOptions, generate};
 use mannequin_data::{Dataset, Fingerprint};
+use mannequin_synth::{SynthOptions, generate};
 
 fn subject(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mannequin-training-{name}-{}", std::process::id()));

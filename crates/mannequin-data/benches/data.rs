@@ -20,10 +20,10 @@ use mannequin_data::metrics::{
     ssim::{ssim, ssim_direct},
 };
 use mannequin_data::rng::SplitMix64;
-use mannequin_data::synth::{SynthOptions, generate};
 use mannequin_data::{Camera, Image};
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
+use mannequin_synth::{SynthOptions, generate};
 
 const SIZE: usize = 540;
 

@@ -16,7 +16,6 @@ pub mod poses;
 pub mod rng;
 pub mod scores;
 pub mod splits;
-pub mod synth;
 pub mod writer;
 
 pub use dataset::{Cameras, Dataset, Frame, Split};

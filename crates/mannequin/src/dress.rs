@@ -13,6 +13,7 @@ use mannequin_cloth::{Attachment, Body, Cloth, Material, Settings, Simulator, qu
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{Category, Dressed, Fit, Garment, SIZE_NAMES, make_garment};
 use mannequin_mesh::{MorphSequence, PointCache, TriMesh, write_scene_glb};
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::body::{BodyArgs, load_body};
@@ -207,8 +208,10 @@ pub fn run(args: Args) -> Result<()> {
         .enumerate()
         .map(|(i, w)| {
             let rest = w.dressed.rest();
+            // Frames are independent: measure them in parallel.
             motion_frames
                 .clone()
+                .into_par_iter()
                 .map(|k| {
                     let positions = &layers[i][k];
                     let (max_edge_strain, mean_edge_strain) =

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use mannequin_body::BodyModel;
-use mannequin_data::synth::{SynthOptions, generate};
+use mannequin_synth::{SynthOptions, generate};
 
 use crate::progress::{JobTimer, bar};
 

@@ -9,6 +9,7 @@ use mannequin_data::image::Image;
 use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_splat::Camera;
+use rayon::prelude::*;
 
 use crate::animate::{clip_camera, write_video};
 use crate::progress::bar;
@@ -81,13 +82,15 @@ pub fn render(
     let folder = dir.join("frames");
     std::fs::create_dir_all(&folder).with_context(|| format!("creating {}", folder.display()))?;
     let progress = bar(body.len() as u64, "rendering");
-    for (f, (b, g)) in body.iter().zip(garments).enumerate() {
+    // Frames in parallel: encoding a PNG is serial work as long as rasterising one.
+    (0..body.len()).into_par_iter().try_for_each(|f| -> Result<()> {
         let path = folder.join(format!("frame_{f:04}.png"));
-        render_frame(scene, b, g, &camera)
+        render_frame(scene, body[f], &garments[f], &camera)
             .write_png(&path)
             .with_context(|| format!("writing {}", path.display()))?;
         progress.inc(1);
-    }
+        Ok(())
+    })?;
     progress.finish_and_clear();
     write_video(&folder, &dir.join("frames.mp4"), body.len(), fps)
 }

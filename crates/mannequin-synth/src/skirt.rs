@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 
-use super::clothing::smoothstep;
-use super::subject::Outfit;
+use crate::clothing::smoothstep;
+use crate::subject::Outfit;
 use mannequin_body::smpl_joint::{L_HIP, L_KNEE, PELVIS, R_HIP, R_KNEE, SPINE1};
 use mannequin_mesh::UvLayout;
 use mannequin_mesh::ring_tube::RingLayout;

@@ -15,13 +15,13 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::Camera;
-use crate::dataset::{Cameras, Frame};
-use crate::error::DataError;
-use crate::poses::{BODY_POSE_LEN, Poses};
-use crate::splits::{SplitRange, Splits};
-use crate::writer::DatasetWriter;
 use mannequin_body::BodyModel;
+use mannequin_data::Camera;
+use mannequin_data::dataset::{Cameras, Frame};
+use mannequin_data::error::DataError;
+use mannequin_data::poses::{BODY_POSE_LEN, Poses};
+use mannequin_data::splits::{SplitRange, Splits};
+use mannequin_data::writer::DatasetWriter;
 use scene::{PosedSequence, Scene};
 use subject::Subject;
 
@@ -144,7 +144,8 @@ pub fn generate(
     options.check()?;
     let subject = Subject::random(options.seed, model.num_betas().min(10));
     let scene = Scene::new(model, &subject)?;
-    let mut rng = crate::rng::SplitMix64::new(options.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xCA97);
+    let mut rng =
+        mannequin_data::rng::SplitMix64::new(options.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xCA97);
 
     // The capture: one camera, the subject turning. The camera also frames the novel poses,
     // which are seen from it too.

@@ -5,9 +5,9 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::subject::{GarmentLook, Pattern, Subject};
-use crate::image::Image;
-use crate::rng::mix;
+use crate::subject::{GarmentLook, Pattern, Subject};
+use mannequin_data::image::Image;
+use mannequin_data::rng::mix;
 
 /// What a surface point is, for colouring.
 #[derive(Debug, Clone, Copy, PartialEq)]

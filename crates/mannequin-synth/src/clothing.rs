@@ -8,8 +8,8 @@
 
 use glam::Vec3;
 
-use super::subject::Outfit;
-use crate::rng::SplitMix64;
+use crate::subject::Outfit;
+use mannequin_data::rng::SplitMix64;
 
 use mannequin_body::smpl_joint as joint;
 

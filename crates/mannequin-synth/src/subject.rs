@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::rng::SplitMix64;
+use mannequin_data::rng::SplitMix64;
 
 /// The clothing variants. Offsets on the body make shirts and trousers; skirts and dresses add a
 /// separate skirt surface that bridges the legs, so the body model alone cannot explain the

@@ -8,17 +8,17 @@ use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::{TriMesh, UvLayout};
 use rayon::prelude::*;
 
-use super::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoothstep};
-use super::skirt::{Skirt, build_skirt, lower_body, skirt_span};
-use super::subject::{Outfit, Subject};
-use super::texture::{BakeInput, SurfacePoint, bake};
-use crate::Camera;
-use crate::error::DataError;
-use crate::image::{Image, Mask};
-use crate::maps::{DepthMap, NormalMap};
-use crate::mesh_raster::{RasterMesh, Shading, rasterize};
-use crate::rng::SplitMix64;
+use crate::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoothstep};
+use crate::skirt::{Skirt, build_skirt, lower_body, skirt_span};
+use crate::subject::{Outfit, Subject};
+use crate::texture::{BakeInput, SurfacePoint, bake};
 use mannequin_body::smpl_joint as joint;
+use mannequin_data::Camera;
+use mannequin_data::error::DataError;
+use mannequin_data::image::{Image, Mask};
+use mannequin_data::maps::{DepthMap, NormalMap};
+use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_data::rng::SplitMix64;
 use mannequin_mesh::ring_tube::RingLayout;
 
 /// Texture sizes: the body's UV atlas and the skirt's strip beside it.

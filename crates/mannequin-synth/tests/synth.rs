@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use mannequin_body::{BodyModel, forward};
 use mannequin_data::metrics::surface_distance::TriangleBvh;
-use mannequin_data::synth::{SynthOptions, generate};
 use mannequin_data::{Dataset, layout};
+use mannequin_synth::{SynthOptions, generate};
 
 fn options(seed: u64, supersample: usize) -> SynthOptions {
     SynthOptions {
