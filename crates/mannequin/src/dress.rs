@@ -20,6 +20,7 @@ use crate::body::{BodyArgs, load_body};
 use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
 
+mod collider;
 mod fit_report;
 mod frames;
 
@@ -161,7 +162,7 @@ pub fn run(args: Args) -> Result<()> {
                 .zip(&layers)
                 .map(|(v, f)| (v.garment.mesh.faces.as_slice(), f.as_slice()))
                 .collect();
-            simulate_layer(w, &inner, &body_frames, &body_faces, &args, motion.fps, schedule.settle)?
+            simulate_layer(w, &inner, &body_frames, &body_faces, &schedule, &args, motion.fps)?
         };
         layers.push(frames);
     }
@@ -332,10 +333,11 @@ fn simulate_layer(
     inner: &[Layer],
     body_frames: &[Vec<[f32; 3]>],
     body_faces: &[[u32; 3]],
+    schedule: &Settling,
     args: &Args,
     fps: f32,
-    settle: usize,
 ) -> Result<Vec<Vec<[f32; 3]>>> {
+    let settle = schedule.settle;
     let garment = worn.garment;
     let rest = worn.dressed.rest();
     let mut mesh = garment.mesh.clone();
@@ -343,20 +345,22 @@ fn simulate_layer(
     let material = Material::named(&garment.recipe.material)?;
     let cloth = Cloth::new(&mesh, &material, &[]).with_context(|| worn.name.clone())?;
 
-    let mut faces = body_faces.to_vec();
-    let mut offset = body_frames[0].len() as u32;
-    for (f, frames) in inner {
-        faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
-        offset += frames[0].len() as u32;
-    }
-    let collider = |k: usize| -> Vec<[f32; 3]> {
-        let mut all = body_frames[k].clone();
-        for (_, frames) in inner {
-            all.extend_from_slice(&frames[k]);
-        }
-        all
-    };
-    let at_rest = collider(0);
+    // The layer skinned (Eq. 3.3) every few frames says which part of the body it can meet.
+    let skinned: Vec<(usize, Vec<[f32; 3]>)> = (0..body_frames.len())
+        .step_by(5)
+        .map(|k| {
+            let (pose, trans) = schedule.pose(k);
+            Ok((k, worn.dressed.posed(pose, trans)?))
+        })
+        .collect::<Result<_>>()?;
+    let collider = collider::Collider::new(body_frames, body_faces, inner, &skinned);
+    tracing::debug!(
+        "{}: collides with {:.0} % of the body",
+        worn.name,
+        100.0 * collider.kept_share(body_faces.len())
+    );
+    let faces = collider.faces.clone();
+    let at_rest = collider.at(0);
     let attachments: Vec<Attachment> = if garment.recipe.category.is_lower_body() {
         waist_loop(&mesh)
             .into_iter()
@@ -373,7 +377,7 @@ fn simulate_layer(
     let mut frames = vec![rest];
     let mut previous = at_rest;
     for k in 1..body_frames.len() {
-        let next = collider(k);
+        let next = collider.at(k);
         sim.step_frame(&previous, &next, dt).with_context(|| {
             let when =
                 if k < settle { "while settling".into() } else { format!("at motion frame {}", k - settle) };

@@ -1,0 +1,82 @@
+//! What a layer collides with: the part of the body it can reach, and the layers under it. The
+//! simulator moves and hashes every collider triangle every substep, and a T-shirt never meets
+//! the feet, so only the body triangles that come near the layer's skinned shape (Eq. 3.3) at
+//! some frame are kept.
+
+use std::collections::HashSet;
+
+/// A body triangle is kept when a corner comes within this far (m) of the skinned layer, give or
+/// take half again (the test is by cells of half this side): cloth hangs and swings a few
+/// centimetres off its skinned place, and hands swing past the hips.
+const REACH: f32 = 0.1;
+
+/// The collider's triangles over the kept body vertices followed by the inner layers' vertices.
+pub struct Collider<'a> {
+    kept: Vec<u32>,
+    pub faces: Vec<[u32; 3]>,
+    body_frames: &'a [Vec<[f32; 3]>],
+    inner: &'a [super::Layer<'a>],
+}
+
+impl<'a> Collider<'a> {
+    /// `skinned`: the layer's skinned positions at some frames, with the frame each is of.
+    pub fn new(
+        body_frames: &'a [Vec<[f32; 3]>],
+        body_faces: &[[u32; 3]],
+        inner: &'a [super::Layer<'a>],
+        skinned: &[(usize, Vec<[f32; 3]>)],
+    ) -> Self {
+        let cell = |p: &[f32; 3]| p.map(|x| (2.0 * x / REACH).floor() as i32);
+        let mut near = vec![false; body_frames[0].len()];
+        for (k, positions) in skinned {
+            let cells: HashSet<[i32; 3]> = positions.iter().map(cell).collect();
+            for (v, p) in body_frames[*k].iter().enumerate() {
+                if near[v] {
+                    continue;
+                }
+                let c = cell(p);
+                near[v] = (-2..=2).any(|x| {
+                    (-2..=2).any(|y| (-2..=2).any(|z| cells.contains(&[c[0] + x, c[1] + y, c[2] + z])))
+                });
+            }
+        }
+        let kept_faces: Vec<[u32; 3]> =
+            body_faces.iter().copied().filter(|t| t.iter().any(|&v| near[v as usize])).collect();
+        let mut index = vec![u32::MAX; near.len()];
+        let mut kept = Vec::new();
+        let mut faces: Vec<[u32; 3]> = kept_faces
+            .iter()
+            .map(|t| {
+                t.map(|v| {
+                    if index[v as usize] == u32::MAX {
+                        index[v as usize] = kept.len() as u32;
+                        kept.push(v);
+                    }
+                    index[v as usize]
+                })
+            })
+            .collect();
+        let mut offset = kept.len() as u32;
+        for (f, frames) in inner {
+            faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
+            offset += frames[0].len() as u32;
+        }
+        Self { kept, faces, body_frames, inner }
+    }
+
+    /// The collider's vertices at schedule frame `k`.
+    pub fn at(&self, k: usize) -> Vec<[f32; 3]> {
+        let body = &self.body_frames[k];
+        let mut all: Vec<[f32; 3]> = self.kept.iter().map(|&v| body[v as usize]).collect();
+        for (_, frames) in self.inner {
+            all.extend_from_slice(&frames[k]);
+        }
+        all
+    }
+
+    /// How many body triangles it kept, of how many.
+    pub fn kept_share(&self, body_faces: usize) -> f32 {
+        let inner: usize = self.inner.iter().map(|(f, _)| f.len()).sum();
+        (self.faces.len() - inner) as f32 / body_faces.max(1) as f32
+    }
+}
