@@ -184,17 +184,17 @@ pub fn run(args: Args) -> Result<()> {
             );
             println!("{} ({}):", w.name, w.garment.recipe.material);
             println!(
-                "  {:<16} {:>8} {:>10} {:>11} {:>10}  verdict",
-                "region", "vertices", "min ease", "mean ease", "strain"
+                "  {:<16} {:>8} {:>10} {:>11} {:>15}  verdict",
+                "region", "vertices", "min ease", "mean ease", "over the limit"
             );
             for r in report {
                 println!(
-                    "  {:<16} {:>8} {:>7.1} cm {:>8.1} cm {:>9.1} %  {}",
+                    "  {:<16} {:>8} {:>7.1} cm {:>8.1} cm {:>13.0} %  {}",
                     r.region,
                     r.vertices,
                     r.min_ease_cm,
                     r.mean_ease_cm,
-                    100.0 * r.max_strain,
+                    100.0 * r.share_over_limit,
                     r.verdict
                 );
             }
