@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use mannequin_io::{NpyArray, Npz, NpzWriter};
-use mannequin_mesh::{SurfacePoint, TriMesh, UvLayout};
+use mannequin_mesh::{SurfacePoint, TriMesh, UvLayout, points};
 
 use crate::error::GarmentError;
 use crate::garment::{Garment, Recipe};
@@ -103,8 +103,4 @@ pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
         .map(|(&face, bary)| SurfacePoint { face: face as u32, bary })
         .collect();
     Ok(Garment { recipe, mesh, binding, offsets: points(&offsets) })
-}
-
-fn points(flat: &[f32]) -> Vec<[f32; 3]> {
-    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
 }

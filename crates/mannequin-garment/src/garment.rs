@@ -40,17 +40,16 @@ pub struct Garment {
 }
 
 impl Garment {
-    /// Binds each vertex of `mesh` (the garment on the body whose rest vertices are `body`) to its
-    /// closest body surface point and stores the rest as offsets: Eq. 3.1.
-    pub fn bind(recipe: Recipe, mesh: TriMesh, body: &[[f32; 3]], body_faces: &[[u32; 3]]) -> Garment {
-        let index = ClosestPoint::new(body, body_faces, 0.03);
+    /// Binds each vertex of `mesh` (the garment on a body at rest) to its closest point of that
+    /// body's surface, found through `body`, and stores the rest as offsets: Eq. 3.1.
+    pub fn bind(recipe: Recipe, mesh: TriMesh, body: &ClosestPoint) -> Garment {
         let (binding, offsets) = mesh
             .positions
             .iter()
             .map(|&g| {
                 let g = Vec3::from(g);
                 let (point, on_body) =
-                    index.query(g).unwrap_or((SurfacePoint { face: 0, bary: [1.0, 0.0, 0.0] }, g));
+                    body.query(g).unwrap_or((SurfacePoint { face: 0, bary: [1.0, 0.0, 0.0] }, g));
                 (point, (g - on_body).to_array())
             })
             .unzip();
@@ -97,7 +96,8 @@ mod tests {
             body_vertices: 4,
             body_faces: 2,
         };
-        let g = Garment::bind(recipe, TriMesh::new(garment_points.clone(), vec![[0, 1, 2]]), &body, &faces);
+        let index = ClosestPoint::new(&body, &faces, 0.5);
+        let g = Garment::bind(recipe, TriMesh::new(garment_points.clone(), vec![[0, 1, 2]]), &index);
         let same = g.on_body(&body, &faces);
         for (a, b) in same.iter().zip(&garment_points) {
             assert!(Vec3::from(*a).distance(Vec3::from(*b)) < 1e-6);

@@ -75,7 +75,7 @@ pub fn make_garment(
         body_vertices: model.num_vertices(),
         body_faces: body.faces.len(),
     };
-    let garment = Garment::bind(recipe, mesh.clone(), &rest, &body.faces);
+    let garment = Garment::bind(recipe, mesh.clone(), &surface);
     mesh.uv = body.uv.as_ref().map(|uv| carried_uvs(&garment, &rest, &body.faces, uv));
     Ok(Garment { mesh, ..garment })
 }

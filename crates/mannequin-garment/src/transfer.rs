@@ -7,6 +7,7 @@
 use glam::{Mat3A, Vec3A};
 use mannequin_body::weight_transfer::{KernelWidth, transfer_weights};
 use mannequin_body::{BodyModel, ShapedBody, frame_skinning, pose_corrected, shape_body};
+use mannequin_mesh::points;
 
 use crate::error::GarmentError;
 use crate::garment::Garment;
@@ -83,8 +84,4 @@ impl<'a> Dressed<'a> {
             })
             .collect())
     }
-}
-
-fn points(flat: &[f32]) -> Vec<[f32; 3]> {
-    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
 }

@@ -28,4 +28,4 @@ pub use laplacian::cotan_laplacian;
 pub use mass::{MassKind, mass_matrix, vertex_areas};
 pub use obj::{Obj, ObjGroup, read_obj, write_obj};
 pub use pc2::PointCache;
-pub use tri_mesh::{MeshError, TriMesh, UvLayout};
+pub use tri_mesh::{MeshError, TriMesh, UvLayout, points};

@@ -6,6 +6,8 @@
 
 use glam::Vec3;
 
+use crate::TriMesh;
+
 /// Edge-length bounds relative to the target, Botsch & Kobbelt's 4/3 and 4/5.
 const LONG: f32 = 4.0 / 3.0;
 const SHORT: f32 = 4.0 / 5.0;
@@ -292,19 +294,10 @@ impl Working {
 
     /// Live faces and the vertices they use, renumbered in order.
     fn compact(self) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-        let mut index = vec![u32::MAX; self.positions.len()];
-        let mut positions = Vec::new();
-        let mut faces = Vec::new();
-        for (tri, _) in self.faces.iter().zip(&self.alive).filter(|(_, alive)| **alive) {
-            faces.push(tri.map(|v| {
-                if index[v as usize] == u32::MAX {
-                    index[v as usize] = positions.len() as u32;
-                    positions.push(self.positions[v as usize].to_array());
-                }
-                index[v as usize]
-            }));
-        }
-        (positions, faces)
+        let live: Vec<usize> = (0..self.faces.len()).filter(|&f| self.alive[f]).collect();
+        let positions = self.positions.iter().map(|p| p.to_array()).collect();
+        let (mesh, _) = TriMesh::new(positions, self.faces).submesh(&live);
+        (mesh.positions, mesh.faces)
     }
 }
 

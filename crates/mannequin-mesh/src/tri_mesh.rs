@@ -100,6 +100,11 @@ impl TriMesh {
     }
 }
 
+/// Flat xyz values (3 per point, as body models and `.npy` arrays store them) as points.
+pub fn points(flat: &[f32]) -> Vec<[f32; 3]> {
+    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
+}
+
 /// The indices (ascending) that `tris` use out of `0..count`, and the map from old index to new.
 fn compact(tris: impl Iterator<Item = [u32; 3]>, count: usize) -> (Vec<u32>, Vec<u32>) {
     let mut used = vec![false; count];

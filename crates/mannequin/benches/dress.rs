@@ -48,42 +48,20 @@ fn main() {
     std::fs::create_dir_all(&dir).unwrap();
     let (walk, cache) = (dir.join("walk.npz"), dir.join("cache"));
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    mannequin(&["motion", "walk", "-o", &s(&walk), "--seconds", &seconds, "--fps", "30"], &cache);
+    let walk_arg = s(&walk);
+    mannequin(&["motion", "walk", "-o", &walk_arg, "--seconds", &seconds, "--fps", "30"], &cache);
+    let dress = |out: &str, extra: &[&str]| {
+        let mut args = vec!["dress", "--garments", "pants,tshirt", "--motion", &walk_arg, "--out", out];
+        args.extend_from_slice(extra);
+        mannequin(&args, &cache)
+    };
     // Make (and cache) the templates first, so both runs below time dressing only.
-    mannequin(
-        &[
-            "dress",
-            "--garments",
-            "pants,tshirt",
-            "--motion",
-            &s(&walk),
-            "--no-simulation",
-            "--no-frames",
-            "--out",
-            &s(&dir.join("warm")),
-        ],
-        &cache,
-    );
+    dress(&s(&dir.join("warm")), &["--no-simulation", "--no-frames"]);
 
     println!("dress: pants + T-shirt (size M) on a {seconds} s walk at 30 fps, default body");
-    let skinned = mannequin(
-        &[
-            "dress",
-            "--garments",
-            "pants,tshirt",
-            "--motion",
-            &s(&walk),
-            "--no-simulation",
-            "--out",
-            &s(&dir.join("skinned")),
-        ],
-        &cache,
-    );
+    let skinned = dress(&s(&dir.join("skinned")), &["--no-simulation"]);
     println!("  skinned only (baseline): {skinned:.1} s  [{}]", stages(&dir.join("skinned")));
-    let simulated = mannequin(
-        &["dress", "--garments", "pants,tshirt", "--motion", &s(&walk), "--out", &s(&dir.join("simulated"))],
-        &cache,
-    );
+    let simulated = dress(&s(&dir.join("simulated")), &[]);
     println!("  simulated (default):     {simulated:.1} s  [{}]", stages(&dir.join("simulated")));
     println!(
         "  simulation costs {:.1}× skinning; target {TARGET_S} s: {:.2} of it ({})",

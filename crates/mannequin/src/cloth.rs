@@ -15,7 +15,7 @@ use mannequin_cloth::{
     Attachment, Body, Cloth, ClothState, MATERIAL_NAMES, Material, Settings, Simulator, quality,
 };
 use mannequin_io::{NpyArray, Npz, NpzWriter};
-use mannequin_mesh::{MorphSequence, PointCache, TriMesh, read_obj, write_scene_glb};
+use mannequin_mesh::{MorphSequence, PointCache, TriMesh, points, read_obj, write_scene_glb};
 use serde::Serialize;
 
 use crate::body::{BodyArgs, load_body};
@@ -139,10 +139,6 @@ struct Progress {
 }
 
 const CHECKPOINT: &str = "checkpoint.npz";
-
-fn points(flat: &[f32]) -> Vec<[f32; 3]> {
-    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
-}
 
 fn write_checkpoint(path: &Path, run: &ClothRun, state: &ClothState, progress: &Progress) -> Result<()> {
     let v = state.positions.len();

@@ -12,7 +12,7 @@ use mannequin_body::{BodyModel, Settling, pose_frames, shape_body, skeletal_anim
 use mannequin_cloth::{Attachment, Body, Cloth, Material, Settings, Simulator, quality};
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{Category, Dressed, Fit, Garment, SIZE_NAMES, make_garment};
-use mannequin_mesh::{MorphSequence, PointCache, TriMesh, write_scene_glb};
+use mannequin_mesh::{MorphSequence, PointCache, TriMesh, points, write_scene_glb};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -497,8 +497,4 @@ fn write_metrics(
     }
     tracing::info!("stages (s): {}", summary["stage_s"]);
     Ok(())
-}
-
-fn points(flat: &[f32]) -> Vec<[f32; 3]> {
-    flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
 }

@@ -5,6 +5,8 @@
 
 use std::collections::HashSet;
 
+use mannequin_mesh::TriMesh;
+
 /// A body triangle is kept when a corner comes within this far (m) of the skinned layer, give or
 /// take half again (the test is by cells of half this side): cloth hangs and swings a few
 /// centimetres off its skinned place, and hands swing past the hips.
@@ -40,22 +42,11 @@ impl<'a> Collider<'a> {
                 });
             }
         }
-        let kept_faces: Vec<[u32; 3]> =
-            body_faces.iter().copied().filter(|t| t.iter().any(|&v| near[v as usize])).collect();
-        let mut index = vec![u32::MAX; near.len()];
-        let mut kept = Vec::new();
-        let mut faces: Vec<[u32; 3]> = kept_faces
-            .iter()
-            .map(|t| {
-                t.map(|v| {
-                    if index[v as usize] == u32::MAX {
-                        index[v as usize] = kept.len() as u32;
-                        kept.push(v);
-                    }
-                    index[v as usize]
-                })
-            })
-            .collect();
+        let kept_faces: Vec<usize> =
+            (0..body_faces.len()).filter(|&f| body_faces[f].iter().any(|&v| near[v as usize])).collect();
+        let body = TriMesh::new(body_frames[0].clone(), body_faces.to_vec());
+        let (part, kept) = body.submesh(&kept_faces);
+        let mut faces = part.faces;
         let mut offset = kept.len() as u32;
         for (f, frames) in inner {
             faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
