@@ -14,6 +14,7 @@ use glam::Vec3;
 use crate::coloured_sweep::sweep;
 use crate::colouring::greedy_colouring;
 use crate::dihedral::{Hinge, wrap_angle};
+use crate::rest_shape::HingeRest;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct BendingConstraint {
@@ -31,23 +32,17 @@ pub(crate) struct BendingConstraints {
 }
 
 impl BendingConstraints {
-    /// Hinges whose rest shape has a degenerate triangle get no constraint (the garment check
-    /// refuses such meshes, so none is lost in practice).
-    pub fn new(rest: &[[f32; 3]], hinges: &[[u32; 4]], bend_compliance: f32) -> Self {
-        let colouring = greedy_colouring(hinges, rest.len());
+    /// Constraints on `hinges` of `particles` particles, at their `rest` angles and with
+    /// compliances from their rest areas and edges.
+    pub fn new(hinges: &[[u32; 4]], rest: &[HingeRest], particles: usize, bend_compliance: f32) -> Self {
+        let colouring = greedy_colouring(hinges, particles);
         let hinges = colouring
             .order
             .iter()
-            .map(|&k| {
-                let particles = hinges[k];
-                let h = Hinge::from_positions(rest, particles);
-                let e = h.b - h.a;
-                let areas = 0.5 * (e.cross(h.c - h.a).length() + e.cross(h.d - h.a).length());
-                BendingConstraint {
-                    particles,
-                    rest_angle: h.angle().unwrap_or(0.0),
-                    compliance: bend_compliance * areas / e.length_squared().max(f32::MIN_POSITIVE),
-                }
+            .map(|&k| BendingConstraint {
+                particles: hinges[k],
+                rest_angle: rest[k].angle,
+                compliance: bend_compliance * rest[k].areas / rest[k].edge_squared.max(f32::MIN_POSITIVE),
             })
             .collect();
         Self { hinges, colours: colouring.colours }

@@ -1,19 +1,20 @@
 //! A validated garment ready to simulate: its vertices as particles with masses, and its stretch
 //! and bending constraints, coloured for parallel projection.
 
-use glam::Vec3;
-use mannequin_mesh::TriMesh;
+use mannequin_mesh::{TriMesh, UvLayout};
 
 use crate::bending::BendingConstraints;
 use crate::error::ClothError;
 use crate::garment_check::check_garment;
 use crate::material::Material;
+use crate::rest_shape::RestShape;
 use crate::stretch::StretchConstraints;
 use crate::topology::topology;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cloth {
-    pub(crate) rest: Vec<[f32; 3]>,
+    /// Where the simulation starts.
+    pub(crate) start: Vec<[f32; 3]>,
     pub(crate) faces: Vec<[u32; 3]>,
     pub(crate) inverse_mass: Vec<f32>,
     pub(crate) stretch: StretchConstraints,
@@ -28,39 +29,49 @@ impl Cloth {
     /// Each triangle gives a third of its mass (area × density) to each of its vertices. Pinned
     /// vertices, and vertices no triangle uses, get inverse mass 0: they never move.
     pub fn new(mesh: &TriMesh, material: &Material, pins: &[u32]) -> Result<Cloth, ClothError> {
+        Self::resting(mesh, RestShape::of_mesh(mesh), material, pins)
+    }
+
+    /// The garment sewn from the flat `pattern` (per face of `mesh`, its corners on their panel,
+    /// in metres) and placed as `mesh`: it starts there and pulls back to the pattern's shape.
+    pub fn sewn(
+        mesh: &TriMesh,
+        pattern: &UvLayout,
+        material: &Material,
+        pins: &[u32],
+    ) -> Result<Cloth, ClothError> {
+        Self::resting(mesh, RestShape::of_pattern(mesh, pattern)?, material, pins)
+    }
+
+    fn resting(
+        mesh: &TriMesh,
+        rest: RestShape,
+        material: &Material,
+        pins: &[u32],
+    ) -> Result<Cloth, ClothError> {
         material.validate()?;
         check_garment(mesh, pins)?;
         let topology = topology(&mesh.faces)?;
-        let rest = mesh.positions.clone();
-        let mut mass = vec![0.0f32; rest.len()];
-        for &tri in &mesh.faces {
-            let [a, b, c] = tri.map(|i| Vec3::from(rest[i as usize]));
-            let third = (b - a).cross(c - a).length() / 6.0 * material.density;
-            for i in tri {
-                mass[i as usize] += third;
-            }
-        }
+        let n = mesh.positions.len();
+        let mass = rest.masses(&mesh.faces, n, material.density);
         let mut inverse_mass: Vec<f32> = mass.iter().map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 }).collect();
         for &p in pins {
             inverse_mass[p as usize] = 0.0;
         }
+        let lengths = rest.edge_lengths(&mesh.faces, &topology);
+        let hinges = rest.hinges(&mesh.faces, &topology);
         Ok(Cloth {
-            stretch: StretchConstraints::new(&rest, &topology.edges, material.stretch_compliance),
-            bending: BendingConstraints::new(&rest, &topology.hinges, material.bend_compliance),
+            stretch: StretchConstraints::new(&topology.edges, &lengths, n, material.stretch_compliance),
+            bending: BendingConstraints::new(&topology.hinges, &hinges, n, material.bend_compliance),
             faces: mesh.faces.clone(),
             inverse_mass,
-            rest,
+            start: mesh.positions.clone(),
             material: *material,
         })
     }
 
     pub fn particle_count(&self) -> usize {
-        self.rest.len()
-    }
-
-    /// The positions the garment was built from: its rest shape.
-    pub fn rest_positions(&self) -> &[[f32; 3]] {
-        &self.rest
+        self.start.len()
     }
 
     pub fn faces(&self) -> &[[u32; 3]] {

@@ -20,11 +20,6 @@ pub(crate) struct Hinge {
 }
 
 impl Hinge {
-    pub fn from_positions(p: &[[f32; 3]], [a, b, c, d]: [u32; 4]) -> Self {
-        let at = |i: u32| Vec3::from(p[i as usize]);
-        Self { a: at(a), b: at(b), c: at(c), d: at(d) }
-    }
-
     fn normals(&self) -> (Vec3, Vec3, Vec3) {
         let e = self.b - self.a;
         (e, e.cross(self.c - self.a), (self.d - self.a).cross(e))

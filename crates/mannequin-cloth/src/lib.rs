@@ -15,6 +15,7 @@ mod garment_check;
 mod material;
 mod phase_times;
 pub mod quality;
+mod rest_shape;
 mod self_contacts;
 mod settings;
 mod simulator;

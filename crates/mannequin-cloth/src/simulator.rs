@@ -39,7 +39,7 @@ pub struct Simulator {
 }
 
 impl Simulator {
-    /// A simulator starting from the cloth's rest shape at rest, colliding with `body` if given,
+    /// A simulator starting from the cloth's start positions at rest, colliding with `body` if given,
     /// with `attachments` (which need a body) following it.
     pub fn new(
         cloth: Cloth,
@@ -58,7 +58,7 @@ impl Simulator {
         let tethers = if anchors.is_empty() {
             Tethers::default()
         } else {
-            Tethers::new(&cloth.rest, &cloth.edges(), &anchors)
+            Tethers::new(n, &cloth.stretch.edges, &anchors)
         };
         Ok(Self {
             tethers,
@@ -68,9 +68,9 @@ impl Simulator {
             contacts: settings
                 .self_collision
                 .then(|| SelfContacts::new(settings.thickness, cloth.edges(), n)),
-            positions: cloth.rest.clone(),
+            positions: cloth.start.clone(),
             velocities: vec![[0.0; 3]; n],
-            previous: cloth.rest.clone(),
+            previous: cloth.start.clone(),
             stretch_lambda: vec![0.0; cloth.stretch.len()],
             bending_lambda: vec![0.0; cloth.bending.len()],
             cloth,

@@ -3,8 +3,6 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
-
 use crate::coloured_sweep::sweep;
 use crate::colouring::greedy_colouring;
 
@@ -18,16 +16,10 @@ pub(crate) struct StretchConstraints {
 }
 
 impl StretchConstraints {
-    pub fn new(rest: &[[f32; 3]], edges: &[[u32; 2]], compliance: f32) -> Self {
-        let colouring = greedy_colouring(edges, rest.len());
-        let edges = colouring
-            .order
-            .iter()
-            .map(|&k| {
-                let [a, b] = edges[k];
-                (edges[k], (Vec3::from(rest[a as usize]) - Vec3::from(rest[b as usize])).length())
-            })
-            .collect();
+    /// Constraints on `edges` of `particles` particles, each to its rest length in `lengths`.
+    pub fn new(edges: &[[u32; 2]], lengths: &[f32], particles: usize, compliance: f32) -> Self {
+        let colouring = greedy_colouring(edges, particles);
+        let edges = colouring.order.iter().map(|&k| (edges[k], lengths[k])).collect();
         Self { edges, colours: colouring.colours, compliance }
     }
 

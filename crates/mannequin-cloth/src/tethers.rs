@@ -18,13 +18,11 @@ pub(crate) struct Tethers {
 }
 
 impl Tethers {
-    /// Tethers from every particle of the mesh `rest`/`edges` to the nearest of `anchors`, by
-    /// path length along edges (Dijkstra from all anchors at once).
-    pub fn new(rest: &[[f32; 3]], edges: &[[u32; 2]], anchors: &[u32]) -> Self {
-        let n = rest.len();
+    /// Tethers from every one of `n` particles to the nearest of `anchors`, by path length along
+    /// `edges` with their rest lengths (Dijkstra from all anchors at once).
+    pub fn new(n: usize, edges: &[([u32; 2], f32)], anchors: &[u32]) -> Self {
         let mut neighbours = vec![Vec::new(); n];
-        for &[a, b] in edges {
-            let l = Vec3::from(rest[a as usize]).distance(Vec3::from(rest[b as usize]));
+        for &([a, b], l) in edges {
             neighbours[a as usize].push((b, l));
             neighbours[b as usize].push((a, l));
         }
@@ -84,9 +82,8 @@ mod tests {
     /// and a particle within its length is left alone.
     #[test]
     fn tethers_follow_the_path_and_pull_only_past_it() {
-        let rest = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0]];
-        let edges = [[0, 1], [1, 2], [2, 3]];
-        let tethers = Tethers::new(&rest, &edges, &[0]);
+        let edges = [([0, 1], 1.0), ([1, 2], 1.0), ([2, 3], 1.0)];
+        let tethers = Tethers::new(4, &edges, &[0]);
         assert_eq!(tethers.links[3], Some((0, 3.0)));
         assert_eq!(tethers.links[0], None);
         let mut positions = vec![[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [1.0, 0.0, 0.0], [10.0, 0.0, 0.0]];

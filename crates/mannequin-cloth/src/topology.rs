@@ -8,8 +8,12 @@ use crate::error::ClothError;
 pub(crate) struct Topology {
     /// Every edge once, `[low, high]`, sorted.
     pub edges: Vec<[u32; 2]>,
+    /// The faces on each side of each edge (the same face twice on a boundary).
+    pub edge_faces: Vec<[usize; 2]>,
     /// `[a, b, c, d]`: edge a–b shared by the triangles (a, b, c) and (a, b, d).
     pub hinges: Vec<[u32; 4]>,
+    /// The faces (a, b, c) and (a, b, d) of each hinge.
+    pub hinge_faces: Vec<[usize; 2]>,
 }
 
 pub(crate) fn topology(faces: &[[u32; 3]]) -> Result<Topology, ClothError> {
@@ -22,11 +26,13 @@ pub(crate) fn topology(faces: &[[u32; 3]]) -> Result<Topology, ClothError> {
         .collect();
     sides.sort_unstable();
     let mut edges = Vec::new();
+    let mut edge_faces = Vec::new();
     let mut hinges = Vec::new();
+    let mut hinge_faces = Vec::new();
     for run in sides.chunk_by(|x, y| x.0 == y.0) {
         let [a, b] = run[0].0;
         match *run {
-            [_] => {}
+            [(_, _, f)] => edge_faces.push([f, f]),
             [(_, c, f), (_, d, g)] => {
                 if c == d {
                     return Err(ClothError::invalid(
@@ -35,12 +41,14 @@ pub(crate) fn topology(faces: &[[u32; 3]]) -> Result<Topology, ClothError> {
                     ));
                 }
                 hinges.push([a, b, c, d]);
+                hinge_faces.push([f, g]);
+                edge_faces.push([f, g]);
             }
             _ => return Err(ClothError::NonManifoldEdge { a, b, count: run.len() }),
         }
         edges.push([a, b]);
     }
-    Ok(Topology { edges, hinges })
+    Ok(Topology { edges, edge_faces, hinges, hinge_faces })
 }
 
 #[cfg(test)]
@@ -52,6 +60,9 @@ mod tests {
         let t = topology(&[[0, 1, 2], [2, 1, 3]]).unwrap();
         assert_eq!(t.edges, vec![[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]);
         assert_eq!(t.hinges, vec![[1, 2, 0, 3]]);
+        assert_eq!(t.hinge_faces, vec![[0, 1]]);
+        assert_eq!(t.edge_faces[2], [0, 1]);
+        assert_eq!(t.edge_faces[0], [0, 0]);
     }
 
     #[test]
