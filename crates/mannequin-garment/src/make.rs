@@ -1,9 +1,11 @@
-//! Making a close-fitting template (thesis §3.2): the covered region of the body's rest surface,
-//! pushed out along the body's normal by the fit's ease and remeshed there to near-uniform
-//! triangles. UVs come from the body's own layout, so a body texture's regions carry over.
+//! Making a template (thesis §3.2): the covered region of the body's rest surface, pushed out
+//! along the body's normal by the fit's ease and remeshed there to near-uniform triangles; for
+//! garments that hang below the seat, a flared panel sewn on and draped. UVs come from the
+//! body's own layout, so a body texture's regions carry over.
 
 use glam::Vec3;
 use mannequin_body::{BodyModel, shape_body};
+use mannequin_cloth::Material;
 use mannequin_mesh::barycentric::plane_barycentric;
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::remesh::remesh;
@@ -13,10 +15,18 @@ use crate::category::Category;
 use crate::error::GarmentError;
 use crate::fit::Fit;
 use crate::garment::{Garment, Recipe};
-use crate::region::{Landmarks, covered_region};
+use crate::region::{Landmarks, covered_region, open_front};
+use crate::sewing::sew_skirt;
+
+/// Changes whenever a recipe makes a different mesh, so that templates cached by an older one
+/// are made anew.
+pub const TEMPLATE_REVISION: u32 = 2;
 
 /// Remeshing rounds: Botsch & Kobbelt find 5–10 enough; the body's 5 cm edges need the upper end.
 const REMESH_ROUNDS: usize = 10;
+/// Rounds after a panel is sewn on or a front cut open, where only the seam, the cut and the
+/// folds need them.
+const SEWN_REMESH_ROUNDS: usize = 3;
 
 /// The template of `category` cut to `fit`, remeshed to `edge_length`, on `model` (named
 /// `body_name`) with shape `betas`, in `material`.
@@ -65,6 +75,22 @@ pub fn make_garment(
         region.positions.iter().map(|&p| onto_eased(Vec3::from(p)).to_array()).collect();
     let (positions, faces) = remesh(&start, &region.faces, edge_length, REMESH_ROUNDS, onto_eased);
     let mut mesh = TriMesh::new(positions, faces);
+    let depth = marks.seat() - marks.hem(category, &fit);
+    let panel = category.flare().filter(|_| depth > 2.0 * edge_length);
+    if panel.is_some() || category == Category::LongCoat {
+        let sewn = match panel {
+            Some(flare) => sew_skirt(&mesh, depth, flare, edge_length, &Material::named(material)?, &body)?,
+            None => mesh,
+        };
+        // The coat opens down the front, through bodice and skirt at once.
+        let cut = if category == Category::LongCoat { open_front(&sewn, &marks) } else { sewn.clone() };
+        // Even out the triangles the seam, the folds and the cut left, on the draped surface.
+        let surface = ClosestPoint::new(&sewn.positions, &sewn.faces, 0.03);
+        let (positions, faces) = remesh(&cut.positions, &cut.faces, edge_length, SEWN_REMESH_ROUNDS, |p| {
+            surface.query(p).map_or(p, |(_, q)| q)
+        });
+        mesh = TriMesh::new(positions, faces);
+    }
     let recipe = Recipe {
         category,
         fit,

@@ -47,6 +47,13 @@ impl Landmarks {
         }
     }
 
+    /// The lowest cut round the body that stays one loop: below the hip joints, above the
+    /// crotch, where a lower cut would go round each thigh. A garment hanging lower leaves the
+    /// body here, as a sewn panel.
+    pub fn seat(&self) -> f32 {
+        self.hips - 0.03
+    }
+
     /// The category's hem height above the soles when the fit does not give one.
     pub fn default_hem_height(&self, category: Category) -> f32 {
         let above_floor = |y: f32| y - self.floor;
@@ -54,10 +61,13 @@ impl Landmarks {
             // Pants reach the ankle bone; shorts stop a hand above the knee.
             Category::Pants => 0.06,
             Category::ShortPants => above_floor(self.knee) + 0.1,
-            // A T-shirt ends above the hip joints, a shirt below them (but above the crotch,
-            // where a lower cut would go round each thigh).
+            // A T-shirt ends above the hip joints, a shirt at the seat.
             Category::Tshirt => above_floor(self.hips) + 0.03,
-            Category::Shirt => above_floor(self.hips) - 0.03,
+            Category::Shirt => above_floor(self.seat()),
+            // A skirt ends above the knee, a dress and a long coat below it.
+            Category::Skirt => above_floor(self.knee) + 0.08,
+            Category::Dress => above_floor(self.knee) - 0.1,
+            Category::LongCoat => above_floor(self.knee) - 0.15,
         }
     }
 
@@ -65,9 +75,15 @@ impl Landmarks {
     pub fn default_sleeve(&self, category: Category) -> f32 {
         match category {
             Category::Tshirt => 0.35,
-            Category::Shirt => 1.0,
-            Category::Pants | Category::ShortPants => 0.0,
+            Category::Dress => 0.1,
+            Category::Shirt | Category::LongCoat => 1.0,
+            Category::Pants | Category::ShortPants | Category::Skirt => 0.0,
         }
+    }
+
+    /// The hem's rest height.
+    pub fn hem(&self, category: Category, fit: &Fit) -> f32 {
+        self.floor + fit.hem_height.unwrap_or_else(|| self.default_hem_height(category))
     }
 
     /// The ease at rest height `y`: the fit's hip, waist and chest values, linear between those
@@ -87,9 +103,10 @@ impl Landmarks {
     }
 }
 
-/// The part of the rest `body` mesh the garment covers (largest connected piece).
+/// The part of the rest `body` mesh the garment covers (largest connected piece); for a
+/// category that hangs free below the seat, the part above it.
 pub fn covered_region(body: &TriMesh, marks: &Landmarks, category: Category, fit: &Fit) -> TriMesh {
-    let hem = marks.floor + fit.hem_height.unwrap_or_else(|| marks.default_hem_height(category));
+    let hem = marks.hem(category, fit).max(if category.flare().is_some() { marks.seat() } else { f32::MIN });
     let mut region = body.clone();
     region.uv = None;
     region.colors = None;
@@ -110,10 +127,31 @@ pub fn covered_region(body: &TriMesh, marks: &Landmarks, category: Category, fit
         region = clip(&region, |p| (p - cuff).dot(axis), SNAP);
     }
     // Neckline: a sphere about a point above the neck joint and forward of it, so the front
-    // dips lower than the back; everything above the neck's top is cut off with it.
+    // dips lower than the back, and everything above the neck's top. One cut by the smooth
+    // union of the two, so that where they meet at the back the collar is rounded, not a
+    // corner that leaves a sliver.
     let centre = marks.neck + Vec3::new(0.0, 0.06, 0.03);
-    region = clip(&region, |p| 0.13 - (p - centre).length(), SNAP);
-    largest_piece(clip(&region, |p| p.y - (marks.neck.y + 0.02), SNAP))
+    let top = marks.neck.y + 0.02;
+    largest_piece(clip(&region, |p| smooth_max(0.13 - (p - centre).length(), p.y - top, 0.02), SNAP))
+}
+
+/// max(a, b) with the corner rounded over about `k`: a hyperbola with the two as asymptotes.
+fn smooth_max(a: f32, b: f32, k: f32) -> f32 {
+    0.5 * (a + b + ((a - b).powi(2) + k * k).sqrt())
+}
+
+/// Half the width of a coat's open front (m).
+const HALF_OPENING: f32 = 0.01;
+
+/// `mesh` cut open down the front from neckline to hem. The front is what lies 5 cm or more
+/// ahead of the neck joint, which sits near the back of the neck: the collar's back stays whole.
+pub fn open_front(mesh: &TriMesh, marks: &Landmarks) -> TriMesh {
+    let centre = marks.neck;
+    largest_piece(clip(
+        mesh,
+        |p| if p.z > centre.z + 0.05 { HALF_OPENING - (p.x - centre.x).abs() } else { -1.0 },
+        SNAP,
+    ))
 }
 
 /// The edge-connected piece with the most faces: a cut can leave crumbs (a nipple's tip, a

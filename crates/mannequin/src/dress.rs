@@ -11,7 +11,7 @@ use clap::Args as ClapArgs;
 use mannequin_body::{BodyModel, Settling, pose_frames, shape_body, skeletal_animation, skinned_body};
 use mannequin_cloth::{Attachment, Body, Cloth, Material, Settings, Simulator, quality};
 use mannequin_garment::file::{read_garment, write_garment};
-use mannequin_garment::{Category, Dressed, Fit, Garment, SIZE_NAMES, make_garment};
+use mannequin_garment::{Category, Dressed, Fit, Garment, SIZE_NAMES, TEMPLATE_REVISION, make_garment};
 use mannequin_mesh::{MorphSequence, PointCache, TriMesh, points, write_scene_glb};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -31,7 +31,7 @@ pub struct Args {
     #[command(flatten)]
     body: BodyArgs,
     /// Garments, inner layer first: .garment files (`mannequin garment make`), or category names
-    /// (pants, short-pants, shirt, tshirt), made at --size on this body and cached.
+    /// (pants, short-pants, shirt, tshirt, long-coat, skirt, dress), made at --size on this body and cached.
     #[arg(long, value_delimiter = ',', required = true)]
     garments: Vec<String>,
     /// The size of garments given by category name.
@@ -296,7 +296,8 @@ fn load_or_make(spec: &str, model: &BodyModel, body: &str, size: &str) -> Result
     } else {
         body.to_string()
     };
-    let key = format!("{}-{size}-{body_key}-v{}", category.name(), env!("CARGO_PKG_VERSION"));
+    let key =
+        format!("{}-{size}-{body_key}-v{}-r{TEMPLATE_REVISION}", category.name(), env!("CARGO_PKG_VERSION"));
     let cache = cache_dir().map(|d| d.join("garments").join(format!("{key}.garment")));
     if let Some(path) = &cache
         && path.exists()

@@ -55,7 +55,7 @@ fn a_made_template_reads_back() {
     let o = mannequin(&["dress", "--garments", s(&lod1), "--motion", s(&walk), "--out", s(&dir.join("x"))]);
     one_line_error(&o, &["lod1", "make it again on this body"]);
     let o = mannequin(&["dress", "--garments", "tunic", "--motion", s(&walk), "--out", s(&dir.join("x"))]);
-    one_line_error(&o, &["tunic", "pants, short-pants, shirt, tshirt"]);
+    one_line_error(&o, &["tunic", "pants, short-pants, shirt, tshirt, long-coat, skirt, dress"]);
 }
 
 #[test]
