@@ -3,6 +3,7 @@
 //! `.garment` files.
 
 pub mod category;
+mod collider;
 mod drape;
 mod error;
 pub mod file;
@@ -14,6 +15,7 @@ mod panel;
 pub mod region;
 mod sewing;
 mod transfer;
+mod wear;
 
 pub use category::{CATEGORY_NAMES, Category};
 pub use error::GarmentError;
@@ -21,3 +23,4 @@ pub use fit::{Fit, SIZE_NAMES};
 pub use garment::{Garment, Recipe};
 pub use make::{TEMPLATE_REVISION, make_garment};
 pub use transfer::Dressed;
+pub use wear::{Wearer, WornLayer, wear};

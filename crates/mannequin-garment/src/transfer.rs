@@ -58,6 +58,10 @@ impl<'a> Dressed<'a> {
         Ok(dressed)
     }
 
+    pub fn garment(&self) -> &'a Garment {
+        self.garment
+    }
+
     /// Eq. 3.2 at rest (θ = 0): I^g T(β, 0) + D^g.
     pub fn rest(&self) -> Vec<[f32; 3]> {
         self.garment.on_body(&points(&self.shaped.vertices), &self.faces)

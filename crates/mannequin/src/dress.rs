@@ -9,10 +9,12 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
 use mannequin_body::{BodyModel, Settling, pose_frames, shape_body, skeletal_animation, skinned_body};
-use mannequin_cloth::{Attachment, Body, Cloth, Material, Settings, Simulator, quality};
+use mannequin_cloth::{Material, Settings, quality};
 use mannequin_garment::file::{read_garment, write_garment};
-use mannequin_garment::{Category, Dressed, Fit, Garment, SIZE_NAMES, TEMPLATE_REVISION, make_garment};
-use mannequin_mesh::{MorphSequence, PointCache, TriMesh, points, write_scene_glb};
+use mannequin_garment::{
+    Category, Dressed, Fit, Garment, SIZE_NAMES, TEMPLATE_REVISION, Wearer, make_garment, wear,
+};
+use mannequin_mesh::{MorphSequence, PointCache, points, write_scene_glb};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -20,7 +22,6 @@ use crate::body::{BodyArgs, load_body};
 use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
 
-mod collider;
 mod fit_report;
 mod frames;
 
@@ -70,10 +71,6 @@ pub struct Args {
 /// How far (m) each layer stands beyond the one under it at rest: twice the simulator's body
 /// margin, so the outer layer starts clear of the inner one's collision shell.
 const LAYER_GAP: f32 = 0.01;
-
-/// A layer under the one being simulated: its triangles, and its positions at every frame of
-/// the schedule.
-type Layer<'a> = (&'a [[u32; 3]], &'a [Vec<[f32; 3]>]);
 
 /// One garment being worn: its name in the outputs, template and transfer to this body.
 struct Worn<'a> {
@@ -147,25 +144,41 @@ pub fn run(args: Args) -> Result<()> {
     stage("body", start);
 
     let start = Instant::now();
-    let mut layers: Vec<Vec<Vec<[f32; 3]>>> = Vec::new();
-    for w in &worn {
-        let frames = if args.no_simulation {
-            (0..schedule.len())
-                .map(|k| {
-                    let (pose, trans) = schedule.pose(k);
-                    Ok(w.dressed.posed(pose, trans)?)
-                })
-                .collect::<Result<_>>()?
-        } else {
-            let inner: Vec<Layer> = worn
-                .iter()
-                .zip(&layers)
-                .map(|(v, f)| (v.garment.mesh.faces.as_slice(), f.as_slice()))
-                .collect();
-            simulate_layer(w, &inner, &body_frames, &body_faces, &schedule, &args, motion.fps)?
-        };
-        layers.push(frames);
-    }
+    let layers: Vec<Vec<Vec<[f32; 3]>>> = if args.no_simulation {
+        worn.iter()
+            .map(|w| {
+                (0..schedule.len())
+                    .map(|k| {
+                        let (pose, trans) = schedule.pose(k);
+                        Ok(w.dressed.posed(pose, trans)?)
+                    })
+                    .collect::<Result<_>>()
+            })
+            .collect::<Result<_>>()?
+    } else {
+        let named: Vec<(&str, &Dressed)> = worn.iter().map(|w| (w.name.as_str(), &w.dressed)).collect();
+        let wearer =
+            Wearer { faces: &body_faces, frames: &body_frames, schedule: &schedule, fps: motion.fps };
+        let settings =
+            Settings { substeps: args.substeps, self_collision: args.self_collision, ..Settings::default() };
+        let progress = bar((worn.len() * (schedule.len() - 1)) as u64, "simulation");
+        let simulated = wear(&named, &wearer, settings, &|_| progress.inc(1))?;
+        progress.finish_and_clear();
+        simulated
+            .into_iter()
+            .zip(&worn)
+            .map(|(layer, w)| {
+                let phases: Vec<String> = layer
+                    .phases
+                    .named()
+                    .iter()
+                    .map(|(name, d)| format!("{name} {:.1} s", d.as_secs_f64()))
+                    .collect();
+                tracing::info!("{}: simulated {} frames; {}", w.name, layer.frames.len(), phases.join(", "));
+                layer.frames
+            })
+            .collect()
+    };
     stage("simulation", start);
 
     if args.fit_report {
@@ -324,89 +337,6 @@ fn cache_dir() -> Option<PathBuf> {
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
         .map(|d| d.join("mannequin"))
-}
-
-/// One layer through the whole schedule (settling included), colliding with the body and the
-/// layers under it; lower-body garments are held at the waist (the loop of their boundary
-/// that is highest at rest), as an elastic waistband holds them.
-fn simulate_layer(
-    worn: &Worn,
-    inner: &[Layer],
-    body_frames: &[Vec<[f32; 3]>],
-    body_faces: &[[u32; 3]],
-    schedule: &Settling,
-    args: &Args,
-    fps: f32,
-) -> Result<Vec<Vec<[f32; 3]>>> {
-    let settle = schedule.settle;
-    let garment = worn.garment;
-    let rest = worn.dressed.rest();
-    let mut mesh = garment.mesh.clone();
-    mesh.positions = rest.clone();
-    let material = Material::named(&garment.recipe.material)?;
-    let cloth = Cloth::new(&mesh, &material, &[]).with_context(|| worn.name.clone())?;
-
-    // The layer skinned (Eq. 3.3) every few frames says which part of the body it can meet.
-    let skinned: Vec<(usize, Vec<[f32; 3]>)> = (0..body_frames.len())
-        .step_by(5)
-        .map(|k| {
-            let (pose, trans) = schedule.pose(k);
-            Ok((k, worn.dressed.posed(pose, trans)?))
-        })
-        .collect::<Result<_>>()?;
-    let collider = collider::Collider::new(body_frames, body_faces, inner, &skinned);
-    tracing::debug!(
-        "{}: collides with {:.0} % of the body",
-        worn.name,
-        100.0 * collider.kept_share(body_faces.len())
-    );
-    let faces = collider.faces.clone();
-    let at_rest = collider.at(0);
-    let attachments: Vec<Attachment> = if garment.recipe.category.is_lower_body() {
-        waist_loop(&mesh)
-            .into_iter()
-            .map(|v| Attachment::bind(&at_rest, &faces, v, mesh.positions[v as usize]))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let settings =
-        Settings { substeps: args.substeps, self_collision: args.self_collision, ..Settings::default() };
-    let mut sim = Simulator::new(cloth, Some(Body::new(faces)), attachments, settings)?;
-    let dt = 1.0 / fps;
-    let progress = bar(body_frames.len() as u64, &worn.name);
-    let mut frames = vec![rest];
-    let mut previous = at_rest;
-    for k in 1..body_frames.len() {
-        let next = collider.at(k);
-        sim.step_frame(&previous, &next, dt).with_context(|| {
-            let when =
-                if k < settle { "while settling".into() } else { format!("at motion frame {}", k - settle) };
-            format!("{} {when}", worn.name)
-        })?;
-        frames.push(sim.positions().to_vec());
-        previous = next;
-        progress.inc(1);
-    }
-    progress.finish_and_clear();
-    let phases: Vec<String> = sim
-        .phase_times()
-        .named()
-        .iter()
-        .map(|(name, d)| format!("{name} {:.1} s", d.as_secs_f64()))
-        .collect();
-    tracing::info!("{}: simulated {} frames; {}", worn.name, frames.len(), phases.join(", "));
-    Ok(frames)
-}
-
-/// The vertices of the boundary loop whose mean height at rest is greatest.
-fn waist_loop(mesh: &TriMesh) -> Vec<u32> {
-    let height =
-        |l: &Vec<u32>| l.iter().map(|&v| mesh.positions[v as usize][1]).sum::<f32>() / l.len() as f32;
-    mannequin_mesh::adjacency::boundary_loops(&mesh.faces)
-        .into_iter()
-        .max_by(|a, b| height(a).total_cmp(&height(b)))
-        .unwrap_or_default()
 }
 
 /// Triangle pairs of two meshes that cross: the pairs of their union less each one's own.

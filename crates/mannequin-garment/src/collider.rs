@@ -7,17 +7,19 @@ use std::collections::HashSet;
 
 use mannequin_mesh::TriMesh;
 
+use crate::wear::Layer;
+
 /// A body triangle is kept when a corner comes within this far (m) of the skinned layer, give or
 /// take half again (the test is by cells of half this side): cloth hangs and swings a few
 /// centimetres off its skinned place, and hands swing past the hips.
 const REACH: f32 = 0.1;
 
 /// The collider's triangles over the kept body vertices followed by the inner layers' vertices.
-pub struct Collider<'a> {
+pub(crate) struct Collider<'a> {
     kept: Vec<u32>,
     pub faces: Vec<[u32; 3]>,
     body_frames: &'a [Vec<[f32; 3]>],
-    inner: &'a [super::Layer<'a>],
+    inner: &'a [Layer<'a>],
 }
 
 impl<'a> Collider<'a> {
@@ -25,7 +27,7 @@ impl<'a> Collider<'a> {
     pub fn new(
         body_frames: &'a [Vec<[f32; 3]>],
         body_faces: &[[u32; 3]],
-        inner: &'a [super::Layer<'a>],
+        inner: &'a [Layer<'a>],
         skinned: &[(usize, Vec<[f32; 3]>)],
     ) -> Self {
         let cell = |p: &[f32; 3]| p.map(|x| (2.0 * x / REACH).floor() as i32);
