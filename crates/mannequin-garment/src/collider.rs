@@ -66,10 +66,4 @@ impl<'a> Collider<'a> {
         }
         all
     }
-
-    /// How many body triangles it kept, of how many.
-    pub fn kept_share(&self, body_faces: usize) -> f32 {
-        let inner: usize = self.inner.iter().map(|(f, _)| f.len()).sum();
-        (self.faces.len() - inner) as f32 / body_faces.max(1) as f32
-    }
 }
