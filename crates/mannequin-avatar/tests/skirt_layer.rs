@@ -11,7 +11,6 @@ use mannequin_avatar::{Avatar, AvatarConfig, Canonical, Method, View, load_views
 use mannequin_body::BodyModel;
 use mannequin_data::metrics::surface_distance::TriangleBvh;
 use mannequin_data::{Dataset, Split};
-use mannequin_synth::skirt::skirt_span;
 use mannequin_synth::subject::Outfit;
 use mannequin_synth::{SynthOptions, generate};
 
@@ -41,9 +40,14 @@ fn a_dress_gets_a_layer_on_the_ground_truth_skirt() {
     let body = Canonical::from_body(&BodyModel::default_body(), &split.poses.betas, 0).unwrap();
     assert!(fit_skirt(&body, &views, SkirtMode::Off).unwrap().is_none(), "off means off");
     let layer = fit_skirt(&body, &views, SkirtMode::Auto).unwrap().expect("a skirt layer");
-    let joints: Vec<Vec3> = body.joints.iter().map(|&j| Vec3::from(j)).collect();
-    let (_, hem) = skirt_span(Outfit::Dress, &joints).unwrap();
-    assert!((layer.hem - hem).abs() < 0.05, "hem at {} m, the generator's at {hem} m", layer.hem);
+    // The dress's hem in the first frame (an A-pose, feet on the floor at y = 0) against the
+    // layer's above the canonical body's soles.
+    let first = dir.join("meshes/garment_dress_0000.ply");
+    let dress = mannequin_mesh::ply::read(&first).expect("the dress's ground-truth mesh");
+    let hem = dress.mesh.positions.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min);
+    let soles = body.vertices.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min);
+    let layer_hem = layer.hem - soles;
+    assert!((layer_hem - hem).abs() < 0.05, "hem {layer_hem} m above the soles, the generator's {hem} m");
 
     // Posed by the avatar (zero offsets at initialisation) into a training frame, the layer's
     // vertices lie on the ground-truth clothed mesh.

@@ -11,6 +11,8 @@ pub const NORMALS: &str = "normals";
 pub const DEPTH: &str = "depth";
 pub const MESHES: &str = "meshes";
 pub const POSES: &str = "poses";
+pub const LABELS: &str = "labels";
+pub const HANDS: &str = "hands";
 /// All frames' SMPL parameters, sliced by each split's range when no per-split file exists.
 pub const ALL_POSES: &str = "poses.npz";
 
@@ -40,6 +42,21 @@ pub fn depth(root: &Path, frame: usize) -> PathBuf {
 
 pub fn mesh(root: &Path, frame: usize) -> PathBuf {
     root.join(MESHES).join(format!("mesh_{frame:04}.ply"))
+}
+
+/// Frame `frame`'s label map (synthetic subjects).
+pub fn label(root: &Path, frame: usize) -> PathBuf {
+    root.join(LABELS).join(format!("label_{frame:04}.png"))
+}
+
+/// Frame `frame`'s hand mask: the pixels where a hand shows (synthetic subjects).
+pub fn hand_mask(root: &Path, frame: usize) -> PathBuf {
+    root.join(HANDS).join(format!("hand_{frame:04}.npy"))
+}
+
+/// Frame `frame`'s ground-truth mesh of the garment `name` (synthetic subjects).
+pub fn garment_mesh(root: &Path, name: &str, frame: usize) -> PathBuf {
+    root.join(MESHES).join(format!("garment_{name}_{frame:04}.ply"))
 }
 
 pub fn split_poses(root: &Path, split: &str) -> PathBuf {

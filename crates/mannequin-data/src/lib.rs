@@ -8,6 +8,7 @@ pub mod fingerprint;
 pub mod frame_files;
 pub mod image;
 pub mod image_decode;
+pub mod labels;
 pub mod layout;
 pub mod maps;
 pub mod mesh_raster;

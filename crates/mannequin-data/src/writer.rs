@@ -8,6 +8,8 @@ use mannequin_mesh::TriMesh;
 
 use crate::dataset::{Cameras, Frame};
 use crate::error::DataError;
+use crate::image::Mask;
+use crate::labels::LabelMap;
 use crate::layout;
 use crate::maps::write_mask_npy;
 use crate::poses::Poses;
@@ -73,5 +75,16 @@ impl DatasetWriter {
     /// Writes a frame's ground-truth mesh (world coordinates) as binary PLY.
     pub fn write_mesh(&self, index: usize, mesh: &TriMesh) -> Result<(), DataError> {
         Ok(mannequin_mesh::ply::write(layout::mesh(&self.root, index), mesh, None)?)
+    }
+
+    /// Writes a frame's ground-truth mesh of the garment `name` (world coordinates).
+    pub fn write_garment_mesh(&self, index: usize, name: &str, mesh: &TriMesh) -> Result<(), DataError> {
+        Ok(mannequin_mesh::ply::write(layout::garment_mesh(&self.root, name, index), mesh, None)?)
+    }
+
+    /// Writes a frame's label map and hand mask.
+    pub fn write_labels(&self, index: usize, labels: &LabelMap, hands: &Mask) -> Result<(), DataError> {
+        labels.write_png(&layout::label(&self.root, index))?;
+        write_mask_npy(&layout::hand_mask(&self.root, index), hands)
     }
 }

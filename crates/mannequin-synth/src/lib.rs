@@ -1,14 +1,15 @@
-//! Synthetic subjects whose every answer is known: a clothed, textured person from the default
-//! body, captured like PeopleSnapshot (one static camera, the person turning in an A-pose), with
-//! novel-view and novel-pose test sets, written in the dataset layout with ground-truth normals,
-//! depth and meshes (see `docs/dataset-format.md`, "Synthetic subjects").
+//! Synthetic subjects whose every answer is known: a textured person from the default body,
+//! dressed in the garment library's garments simulated on the motion, captured like
+//! PeopleSnapshot (one static camera, the person turning in an A-pose), with novel-view and
+//! novel-pose test sets, written in the dataset layout with ground-truth normals, depth, meshes
+//! (the whole and each garment), label maps and hand masks (see `docs/dataset-format.md`,
+//! "Synthetic subjects").
 
-pub mod clothing;
 pub mod motion;
 pub mod scene;
-pub mod skirt;
 pub mod subject;
 pub mod texture;
+pub mod wardrobe;
 
 use std::path::Path;
 
@@ -24,6 +25,11 @@ use mannequin_data::splits::{SplitRange, Splits};
 use mannequin_data::writer::DatasetWriter;
 use scene::{PosedSequence, Scene};
 use subject::Subject;
+
+/// The capture's frame rate: 120 frames turn the subject 1.25 times in 4 s.
+const CAPTURE_FPS: f32 = 30.0;
+/// Poses the cloth simulator sees per frame of the out-of-distribution motions (about 30 fps).
+const NOVEL_SUBFRAMES: usize = 4;
 
 /// Sizes of the generated dataset.
 #[derive(Debug, Clone, Serialize)]
@@ -91,6 +97,8 @@ pub struct SynthSummary {
     pub faces: usize,
     pub novel_view_cameras: Vec<&'static str>,
     pub novel_pose_motions: Vec<&'static str>,
+    /// The label maps' values, by index.
+    pub labels: Vec<&'static str>,
 }
 
 fn split_poses(betas: &[f32], poses72: &[f32], transl: &[[f32; 3]]) -> Poses {
@@ -127,7 +135,11 @@ fn write_frames(
             normals: Some(r.normals),
             depth: Some(r.depth),
         })?;
+        writer.write_labels(i, &r.labels, &r.hands)?;
         writer.write_mesh(i, &mesh)?;
+        for (name, garment) in seq.garment_meshes(scene, i) {
+            writer.write_garment_mesh(i, name, &garment)?;
+        }
         on_frame();
         Ok(())
     })
@@ -150,9 +162,16 @@ pub fn generate(
     // The capture: one camera, the subject turning. The camera also frames the novel poses,
     // which are seen from it too.
     let capture_poses = motion::turning_a_pose(options.capture_frames, 1.25, &mut rng)?;
-    let capture = scene.pose(model, &capture_poses)?;
+    let capture = scene.pose(model, &capture_poses, CAPTURE_FPS, 1)?;
     let (motion_names, novel_poses) = motion::novel_poses(options.motion_frames, &mut rng)?;
-    let novel = scene.pose(model, &novel_poses)?;
+    // Each motion played apart, from rest: one after another they would jump between motions.
+    let mut novel = PosedSequence { vertices: Vec::new(), transl: Vec::new() };
+    for clip in novel_poses.chunks(72 * options.motion_frames) {
+        let played =
+            scene.pose(model, clip, motion::novel_pose_fps(options.motion_frames), NOVEL_SUBFRAMES)?;
+        novel.vertices.extend(played.vertices);
+        novel.transl.extend(played.transl);
+    }
     let camera = scene.framing_camera(&[&capture, &novel], scene::TRAIN_VIEW, options.size);
     let root = DatasetWriter::new(out);
     root.write_cameras(&Cameras::Static(camera.clone()))?;
@@ -183,7 +202,8 @@ pub fn generate(
     let view_frames: Vec<usize> = (0..scene::NOVEL_VIEWS).flat_map(|_| picks.iter().copied()).collect();
     let view_poses: Vec<f32> =
         view_frames.iter().flat_map(|&f| capture_poses[72 * f..72 * f + 72].to_vec()).collect();
-    let views = scene.pose(model, &view_poses)?;
+    // The capture's frames, garments as they were then.
+    let views = capture.select(&view_frames);
     let view_cameras: Vec<Camera> = (0..scene::NOVEL_VIEWS)
         .flat_map(|v| {
             let cam = scene.framing_camera(&[&views], scene::NOVEL_VIEW_SETUPS[v].1, options.size);
@@ -213,6 +233,7 @@ pub fn generate(
         faces: scene.faces.len(),
         novel_view_cameras: scene::NOVEL_VIEW_SETUPS.iter().map(|s| s.0).collect(),
         novel_pose_motions: motions,
+        labels: scene.legend(),
     };
     let path = out.join("subject.json");
     let text = serde_json::to_string_pretty(&summary).map_err(|e| DataError::file(&path, e.to_string()))?;

@@ -36,6 +36,12 @@ pub fn turning_a_pose(frames: usize, turns: f32, rng: &mut SplitMix64) -> Result
     Ok(poses)
 }
 
+/// The frame rate of the out-of-distribution motions: `frames_each` frames of each take
+/// about a second, a stride of the walk.
+pub fn novel_pose_fps(frames_each: usize) -> f32 {
+    frames_each as f32 * 0.9
+}
+
 /// Linear blend of two poses in axis-angle, per joint (fine for the moderate angles used).
 fn blend(a: &[f32; 72], b: &[f32; 72], t: f32) -> [f32; 72] {
     std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t)
@@ -49,7 +55,7 @@ pub fn novel_poses(
     rng: &mut SplitMix64,
 ) -> Result<(Vec<&'static str>, Vec<f32>), BodyError> {
     let a = named_pose("a-pose")?;
-    let walk = Motion::walk_cycle(1.0 / 0.9, frames_each as f32 * 0.9);
+    let walk = Motion::walk_cycle(1.0 / 0.9, novel_pose_fps(frames_each));
     let mut names = Vec::new();
     let mut poses = Vec::new();
     for name in ["walk", "arms-raised", "squat", "arms-crossed"] {

@@ -1,29 +1,37 @@
-//! The clothed, textured subject as one skinned mesh (body with clothing offsets, plus a skirt
-//! for skirt outfits), posed per frame and rendered with the ground-truth rasterizer.
+//! The clothed, textured subject: the body (skin, hair, shoes) and the library's garments as
+//! separate meshes, posed per frame (the garments by the cloth simulator) and rendered with the
+//! ground-truth rasterizer, with a label map and a hand mask beside each image.
 
 use glam::{DVec3, Vec3};
-use mannequin_body::kinematics::skinning_transforms;
-use mannequin_body::{BodyModel, ShapedBody, pose_frames, shape_body};
+use mannequin_body::{BodyModel, Motion, Settling, ShapedBody, pose_frames, shape_body};
+use mannequin_cloth::Settings;
+use mannequin_garment::{Dressed, GarmentError, Wearer, wear};
 use mannequin_mesh::normals::vertex_normals;
-use mannequin_mesh::{TriMesh, UvLayout};
+use mannequin_mesh::{TriMesh, UvLayout, points};
 use rayon::prelude::*;
 
-use crate::clothing::{self, Folds, GarmentSpec, garment_specs, membership, smoothstep};
-use crate::skirt::{Skirt, build_skirt, lower_body, skirt_span};
-use crate::subject::{Outfit, Subject};
-use crate::texture::{BakeInput, SurfacePoint, bake};
+use crate::subject::Subject;
+use crate::texture::{BakeInput, SurfacePoint, bake, smoothstep};
+use crate::wardrobe::{Piece, Worn, dress_subject, triangle_atlas};
 use mannequin_body::smpl_joint as joint;
 use mannequin_data::Camera;
 use mannequin_data::error::DataError;
 use mannequin_data::image::{Image, Mask};
+use mannequin_data::labels::LabelMap;
 use mannequin_data::maps::{DepthMap, NormalMap};
-use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_data::mesh_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 use mannequin_data::rng::SplitMix64;
-use mannequin_mesh::ring_tube::RingLayout;
 
-/// Texture sizes: the body's UV atlas and the skirt's strip beside it.
-const BODY_TEXTURE: usize = 1024;
-const SKIRT_TEXTURE: usize = 1024;
+/// Texture size of the body's UV atlas and of each garment's triangle atlas beside it (square,
+/// all one size, so the atlas's rows line up).
+const TEXTURE: usize = 2048;
+/// Share of each garment triangle's atlas cell left round it for the baker's dilation.
+const ATLAS_MARGIN: f32 = 0.12;
+/// Seconds the garments settle on the body before each sequence's first frame.
+const SETTLE_SECONDS: f32 = 1.0;
+/// Cloth substeps per second of motion: `mannequin dress`'s at 30 fps (at half that, a T-shirt
+/// slides off the shoulders in the walk).
+const SUBSTEPS_PER_SECOND: f32 = 600.0;
 
 /// Where a camera looks from, relative to the subject's bounding box centre: azimuth about +Y
 /// (0 is in front, on +Z), elevation, distance as a multiple of 3.3 m, and roll.
@@ -44,19 +52,25 @@ pub const NOVEL_VIEW_SETUPS: [(&str, ViewSetup); NOVEL_VIEWS] = [
 ];
 
 pub struct Scene {
-    /// Rest-pose clothed body (with the body model's joints) that LBS poses.
-    clothed: ShapedBody,
-    skirt_weights: Vec<[(usize, f32); 3]>,
-    /// Rest positions of all vertices: body first, then the skirt.
+    /// The subject's body at rest, unclothed.
+    shaped: ShapedBody,
+    body_faces: Vec<[u32; 3]>,
+    betas: Vec<f32>,
+    /// The garments, inner layer first.
+    pub worn: Vec<Worn>,
+    /// Rest positions of all vertices: the body's, then each garment's.
     pub positions: Vec<[f32; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub uv: UvLayout,
     pub texture: Image,
+    /// Per face, its label (an index into [`Scene::legend`]) and whether it is a hand's.
+    face_labels: Vec<u8>,
+    hand_faces: Vec<bool>,
     background: ([f32; 3], [f32; 3]),
 }
 
-/// Posed vertices of a sequence, feet on the floor (y = 0), and the translations that put them
-/// there (the `transl` of the pose files).
+/// Posed vertices of a sequence (the body's, then each garment's), feet on the floor (y = 0),
+/// and the translations that put them there (the `transl` of the pose files).
 pub struct PosedSequence {
     pub vertices: Vec<Vec<[f32; 3]>>,
     pub transl: Vec<[f32; 3]>,
@@ -68,6 +82,8 @@ pub struct Rendered {
     pub mask: Mask,
     pub normals: NormalMap,
     pub depth: DepthMap,
+    pub labels: LabelMap,
+    pub hands: Mask,
 }
 
 impl PosedSequence {
@@ -79,21 +95,45 @@ impl PosedSequence {
         self.vertices.is_empty()
     }
 
-    /// The ground-truth mesh of frame `i`, world coordinates.
+    /// The frames at `picks`.
+    pub fn select(&self, picks: &[usize]) -> Self {
+        Self {
+            vertices: picks.iter().map(|&i| self.vertices[i].clone()).collect(),
+            transl: picks.iter().map(|&i| self.transl[i]).collect(),
+        }
+    }
+
+    /// The ground-truth mesh of frame `i`, world coordinates: body and garments in one.
     pub fn mesh(&self, scene: &Scene, i: usize) -> TriMesh {
         TriMesh::new(self.vertices[i].clone(), scene.faces.clone())
     }
+
+    /// Each garment's ground-truth mesh at frame `i`, with its name.
+    pub fn garment_meshes(&self, scene: &Scene, i: usize) -> Vec<(&'static str, TriMesh)> {
+        let mut start = scene.shaped.vertices.len() / 3;
+        scene
+            .worn
+            .iter()
+            .map(|w| {
+                let n = w.garment.vertex_count();
+                let positions = self.vertices[i][start..start + n].to_vec();
+                start += n;
+                (w.name, TriMesh::new(positions, w.garment.mesh.faces.clone()))
+            })
+            .collect()
+    }
 }
 
-/// Concatenates two textures side by side.
-fn side_by_side(a: &Image, b: &Image) -> Image {
-    let (w, h) = (a.width + b.width, a.height.max(b.height));
-    let pixels = (0..w * h)
-        .map(|p| {
-            let (x, y) = (p % w, p / w);
-            if x < a.width { a.at(x, y.min(a.height - 1)) } else { b.at(x - a.width, y.min(b.height - 1)) }
-        })
-        .collect();
+/// Textures side by side, each squeezed into its share of the atlas's width.
+fn side_by_side(textures: &[&Image]) -> Image {
+    let (w, h) =
+        (textures.iter().map(|t| t.width).sum(), textures.iter().map(|t| t.height).max().unwrap_or(1));
+    let mut pixels = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for t in textures {
+            pixels.extend((0..t.width).map(|x| t.at(x, y.min(t.height - 1))));
+        }
+    }
     Image { width: w, height: h, pixels }
 }
 
@@ -105,28 +145,26 @@ fn remap_uv(uv: &UvLayout, offset: f32, scale: f32, base: u32) -> (Vec<[f32; 2]>
     )
 }
 
+/// Labels of the body's faces (skin, hair, shoes) and of each garment after them.
+pub const BODY_LABELS: [&str; 4] = ["background", "skin", "hair", "shoes"];
+
 impl Scene {
     pub fn new(model: &BodyModel, subject: &Subject) -> Result<Self, DataError> {
         let body_uv = model.uv.as_ref().ok_or_else(|| {
             DataError::Invalid(format!("body model '{}' has no UV layout to paint a texture on", model.name))
         })?;
         let shaped = shape_body(model, &subject.betas)?;
-        let rest: Vec<[f32; 3]> = shaped.vertices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let normals = vertex_normals(&rest, &model.faces);
+        let rest: Vec<[f32; 3]> = points(&shaped.vertices);
         let joints = model.num_joints();
         let weights = model.weights();
-        let (top, bottom) = garment_specs(subject.outfit);
-        let g_top = membership(weights, joints, &top.coverage);
-        let g_bottom = membership(weights, joints, &bottom.coverage);
-        let mut rng = SplitMix64::new(subject.seed ^ 0xF01D5);
-        let (folds_top, folds_bottom) = (Folds::new(&mut rng, 6), Folds::new(&mut rng, 6));
-        let garments: [(&GarmentSpec, &[f32], &Folds); 2] =
-            [(&top, &g_top, &folds_top), (&bottom, &g_bottom, &folds_bottom)];
-        let clothed_rest = clothing::clothe(&rest, &normals, &garments);
 
-        // Hair on the top and back of the head, shoes on the feet.
+        // Hair on the top and back of the head, shoes on the feet; hands for the hand masks.
         let head = shaped.joints[joint::HEAD];
-        let points: Vec<SurfacePoint> = (0..rest.len())
+        let strongest = |v: usize| {
+            let w = &weights[v * joints..(v + 1) * joints];
+            (0..joints).max_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0)
+        };
+        let body_points: Vec<SurfacePoint> = (0..rest.len())
             .map(|v| {
                 let w = &weights[v * joints..(v + 1) * joints];
                 let p = Vec3::from(rest[v]);
@@ -137,109 +175,171 @@ impl Scene {
                     .iter()
                     .map(|&j| w.get(j).copied().unwrap_or(0.0))
                     .sum();
-                SurfacePoint { position: p, layers: [g_top[v], g_bottom[v], on_head * scalp, feet] }
+                SurfacePoint { position: p, layers: [0.0, 0.0, on_head * scalp, feet] }
             })
             .collect();
-
-        let skirt = skirt_span(subject.outfit, &shaped.joints).map(|(waist, hem)| {
-            let inside = lower_body(&clothed_rest, weights, joints);
-            build_skirt(
-                &inside,
-                shaped.joints[joint::PELVIS],
-                (waist, hem),
-                (0.012, 0.35),
-                &RingLayout::uniform(64, 28),
-            )
-        });
-
+        let chest = head - Vec3::new(0.0, 0.25, 0.0);
         let body_texture = bake(
-            &BakeInput { uv: body_uv, faces: &model.faces, points: &points },
+            &BakeInput { uv: body_uv, faces: &model.faces, points: &body_points },
             subject,
-            head - Vec3::new(0.0, 0.25, 0.0),
-            BODY_TEXTURE,
-            BODY_TEXTURE,
+            chest,
+            TEXTURE,
+            TEXTURE,
         );
-        let mut positions = clothed_rest.clone();
+        let mut face_labels: Vec<u8> = model
+            .faces
+            .iter()
+            .map(|tri| {
+                let mean =
+                    |l: usize| tri.iter().map(|&v| body_points[v as usize].layers[l]).sum::<f32>() / 3.0;
+                if mean(3) > 0.5 {
+                    3
+                } else if mean(2) > 0.5 {
+                    2
+                } else {
+                    1
+                }
+            })
+            .collect();
+        let hands = [joint::L_WRIST, joint::R_WRIST, joint::L_HAND, joint::R_HAND];
+        let mut hand_faces: Vec<bool> = model
+            .faces
+            .iter()
+            .map(|tri| tri.iter().filter(|&&v| hands.contains(&strongest(v as usize))).count() >= 2)
+            .collect();
+
+        let worn = dress_subject(model, &subject.betas, subject.outfit)?;
+        let mut positions = rest;
         let mut faces = model.faces.clone();
-        let (texture, uv) = match &skirt {
-            None => (body_texture, body_uv.clone()),
-            Some(s) => Self::add_skirt(s, subject, body_uv, body_texture, head, &mut positions, &mut faces),
-        };
+        let mut textures = vec![body_texture];
+        let mut layouts = vec![body_uv.clone()];
+        for (k, w) in worn.iter().enumerate() {
+            let layers = match w.piece {
+                Piece::Top => [1.0, 0.0, 0.0, 0.0],
+                Piece::Bottom => [0.0, 1.0, 0.0, 0.0],
+            };
+            let mesh = &w.garment.mesh;
+            let points: Vec<SurfacePoint> =
+                mesh.positions.iter().map(|p| SurfacePoint { position: Vec3::from(*p), layers }).collect();
+            let atlas = triangle_atlas(mesh, ATLAS_MARGIN);
+            let input = BakeInput { uv: &atlas, faces: &mesh.faces, points: &points };
+            textures.push(bake(&input, subject, chest, TEXTURE, TEXTURE));
+            layouts.push(atlas);
+            let base = positions.len() as u32;
+            positions.extend_from_slice(&mesh.positions);
+            faces.extend(mesh.faces.iter().map(|t| t.map(|i| i + base)));
+            face_labels.extend(std::iter::repeat_n((BODY_LABELS.len() + k) as u8, mesh.faces.len()));
+            hand_faces.extend(std::iter::repeat_n(false, mesh.faces.len()));
+        }
+        let total: usize = textures.iter().map(|t| t.width).sum();
+        let (mut coords, mut uv_faces, mut offset) = (Vec::new(), Vec::new(), 0.0);
+        for (t, layout) in textures.iter().zip(&layouts) {
+            let share = t.width as f32 / total as f32;
+            let (c, f) = remap_uv(layout, offset, share, coords.len() as u32);
+            coords.extend(c);
+            uv_faces.extend(f);
+            offset += share;
+        }
+        let texture = side_by_side(&textures.iter().collect::<Vec<_>>());
         let mut bg = SplitMix64::new(subject.seed ^ 0xBAC6);
         let grey = bg.range(0.35, 0.8) as f32;
         let tint = [0; 3].map(|_| (grey + bg.range(-0.08, 0.08) as f32).clamp(0.0, 1.0));
-        let flat: Vec<f32> = clothed_rest.iter().flatten().copied().collect();
         Ok(Self {
-            clothed: ShapedBody { vertices: flat, joints: shaped.joints },
-            skirt_weights: skirt.map(|s| s.weights).unwrap_or_default(),
+            shaped,
+            body_faces: model.faces.clone(),
+            betas: subject.betas.clone(),
+            worn,
             positions,
             faces,
-            uv,
+            uv: UvLayout { coords, faces: uv_faces },
             texture,
+            face_labels,
+            hand_faces,
             background: (tint, tint.map(|c| c * 0.75)),
         })
     }
 
-    /// Appends the skirt's vertices and faces and returns the atlas (body | skirt) and its UVs.
-    fn add_skirt(
-        s: &Skirt,
-        subject: &Subject,
-        body_uv: &UvLayout,
-        body_texture: Image,
-        head: Vec3,
-        positions: &mut Vec<[f32; 3]>,
-        faces: &mut Vec<[u32; 3]>,
-    ) -> (Image, UvLayout) {
-        let layers =
-            if subject.outfit == Outfit::Dress { [1.0, 0.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0, 0.0] };
-        let points: Vec<SurfacePoint> =
-            s.positions.iter().map(|p| SurfacePoint { position: Vec3::from(*p), layers }).collect();
-        let chest = head - Vec3::new(0.0, 0.25, 0.0);
-        let skirt_texture = bake(
-            &BakeInput { uv: &s.uv, faces: &s.faces, points: &points },
-            subject,
-            chest,
-            SKIRT_TEXTURE,
-            BODY_TEXTURE,
-        );
-        let atlas = side_by_side(&body_texture, &skirt_texture);
-        let body_share = BODY_TEXTURE as f32 / (BODY_TEXTURE + SKIRT_TEXTURE) as f32;
-        let (mut coords, mut uv_faces) = remap_uv(body_uv, 0.0, body_share, 0);
-        let (c2, f2) = remap_uv(&s.uv, body_share, 1.0 - body_share, coords.len() as u32);
-        coords.extend(c2);
-        uv_faces.extend(f2);
-        let base = positions.len() as u32;
-        positions.extend_from_slice(&s.positions);
-        faces.extend(s.faces.iter().map(|f| f.map(|i| i + base)));
-        (atlas, UvLayout { coords, faces: uv_faces })
+    /// The label names, by index: background, skin, hair, shoes, then each garment.
+    pub fn legend(&self) -> Vec<&'static str> {
+        BODY_LABELS.iter().copied().chain(self.worn.iter().map(|w| w.name)).collect()
     }
 
-    /// Poses every frame of `poses` (F × 72) and lifts each so the lowest vertex touches y = 0.
-    pub fn pose(&self, model: &BodyModel, poses: &[f32]) -> Result<PosedSequence, DataError> {
+    /// Poses every frame of `poses` (F × 72, played at `fps`), each lifted so the body's lowest
+    /// vertex touches y = 0, and plays the garments through it with the cloth simulator, from
+    /// rest, after settling into the first frame. The simulator sees `subframes` poses per frame,
+    /// blended between the frames: its body moves linearly between the poses it is given, which
+    /// for a swinging limb far apart cuts the corner through the cloth.
+    pub fn pose(
+        &self,
+        model: &BodyModel,
+        poses: &[f32],
+        fps: f32,
+        subframes: usize,
+    ) -> Result<PosedSequence, DataError> {
         let frames = poses.len() / 72;
-        let posed = pose_frames(model, &self.clothed, poses, &vec![0.0; 3 * frames])?;
-        let joints = model.num_joints();
-        let (vertices, transl): (Vec<Vec<[f32; 3]>>, Vec<[f32; 3]>) = (0..frames)
-            .into_par_iter()
-            .map(|f| {
-                let mut v: Vec<[f32; 3]> =
-                    posed.frame_vertices(f).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-                let skinning = skinning_transforms(
-                    &posed.transforms[f * joints..(f + 1) * joints],
-                    &self.clothed.joints,
-                );
-                let body = v.len();
-                for (k, w) in self.skirt_weights.iter().enumerate() {
-                    let p = glam::Vec3A::from(self.positions[body + k]);
-                    let q: glam::Vec3A = w.iter().map(|&(j, wj)| skinning[j].transform_point3a(p) * wj).sum();
-                    v.push(q.to_array());
-                }
-                let lift = -v.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min);
-                v.iter_mut().for_each(|p| p[1] += lift);
-                (v, [0.0, lift, 0.0])
+        let dense: Vec<f32> = (0..frames)
+            .flat_map(|f| {
+                let (a, b) = (&poses[72 * f..72 * f + 72], &poses[72 * (f + 1).min(frames - 1)..][..72]);
+                let steps = if f + 1 < frames { subframes } else { 1 };
+                (0..steps).flat_map(move |s| {
+                    let t = s as f32 / subframes as f32;
+                    (0..72).map(move |i| a[i] + (b[i] - a[i]) * t)
+                })
             })
-            .unzip();
-        Ok(PosedSequence { vertices, transl })
+            .collect();
+        let played = self.play(model, &dense, fps * subframes as f32)?;
+        Ok(played.select(&(0..frames).map(|f| f * subframes).collect::<Vec<_>>()))
+    }
+
+    fn play(&self, model: &BodyModel, poses: &[f32], fps: f32) -> Result<PosedSequence, DataError> {
+        let frames = poses.len() / 72;
+        let still = pose_frames(model, &self.shaped, poses, &vec![0.0; 3 * frames])?;
+        let lift: Vec<f32> = (0..frames)
+            .map(|f| -still.frame_vertices(f).chunks_exact(3).map(|p| p[1]).fold(f32::INFINITY, f32::min))
+            .collect();
+        // The cloth plays the lifts relative to the first frame's (settling starts from rest at
+        // the origin, and a body jumping a metre up while it settles would leave it behind);
+        // the first frame's lift moves everything afterwards.
+        let motion = Motion {
+            source: "synthetic".into(),
+            poses: poses.to_vec(),
+            joints: 24,
+            trans: lift.iter().flat_map(|&y| [0.0, y - lift[0], 0.0]).collect(),
+            betas: self.betas.clone(),
+            fps,
+            gender: None,
+        };
+        let schedule = Settling::new(model, &motion, SETTLE_SECONDS)?;
+        let body_frames: Vec<Vec<[f32; 3]>> = (0..schedule.len())
+            .into_par_iter()
+            .map(|k| {
+                let (pose, trans) = schedule.pose(k);
+                Ok(points(pose_frames(model, &self.shaped, pose, trans)?.frame_vertices(0)))
+            })
+            .collect::<Result<_, DataError>>()?;
+        let fail = |e: GarmentError| DataError::Invalid(format!("dressing the subject: {e}"));
+        let dressed: Vec<Dressed> = self
+            .worn
+            .iter()
+            .map(|w| Dressed::new(&w.garment, model, &self.betas))
+            .collect::<Result<_, _>>()
+            .map_err(fail)?;
+        let named: Vec<(&str, &Dressed)> = self.worn.iter().zip(&dressed).map(|(w, d)| (w.name, d)).collect();
+        let wearer = Wearer { faces: &self.body_faces, frames: &body_frames, schedule: &schedule, fps };
+        let substeps = (SUBSTEPS_PER_SECOND / fps).ceil() as u32;
+        let settings = Settings { substeps, self_collision: false, ..Settings::default() };
+        let layers = wear(&named, &wearer, settings, &|_| ()).map_err(fail)?;
+        let vertices = (schedule.settle..schedule.len())
+            .map(|k| {
+                let mut all = body_frames[k].clone();
+                for layer in &layers {
+                    all.extend_from_slice(&layer.frames[k]);
+                }
+                all.iter_mut().for_each(|p| p[1] += lift[0]);
+                all
+            })
+            .collect();
+        Ok(PosedSequence { vertices, transl: lift.iter().map(|&y| [0.0, y, 0.0]).collect() })
     }
 
     /// A camera of `setup` that frames every frame of `seqs` with a margin.
@@ -292,6 +392,7 @@ impl Scene {
                 *p = [0, 1, 2].map(|c| top[c] + (bottom[c] - top[c]) * t);
             }
         }
+        let (labels, hands) = self.labels(&r.face_id, big.width, big.height, supersample);
         let mask = r.mask.downscale(supersample);
         let mut normals = r.normals.downscale(supersample);
         let mut depth = r.depth.downscale(supersample);
@@ -302,6 +403,36 @@ impl Scene {
                 depth.depth[i] = 0.0;
             }
         }
-        Rendered { color: r.color.downscale(supersample), mask, normals, depth }
+        Rendered { color: r.color.downscale(supersample), mask, normals, depth, labels, hands }
+    }
+
+    /// The label map and hand mask at 1/`factor` of the rendered `face_id` image: each pixel
+    /// takes the label most of its samples show (the lower index on a tie), and is a hand's
+    /// when most of its samples are.
+    fn labels(&self, face_id: &[u32], width: usize, height: usize, factor: usize) -> (LabelMap, Mask) {
+        let (w, h) = (width / factor, height / factor);
+        let mut labels = Vec::with_capacity(w * h);
+        let mut hands = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let mut votes = [0usize; 256];
+                let mut hand = 0;
+                for sy in 0..factor {
+                    for sx in 0..factor {
+                        let f = face_id[(y * factor + sy) * width + x * factor + sx];
+                        if f == NO_FACE {
+                            votes[0] += 1;
+                        } else {
+                            votes[self.face_labels[f as usize] as usize] += 1;
+                            hand += usize::from(self.hand_faces[f as usize]);
+                        }
+                    }
+                }
+                let best = (0..256).max_by(|&a, &b| votes[a].cmp(&votes[b]).then(b.cmp(&a))).unwrap_or(0);
+                labels.push(best as u8);
+                hands.push(2 * hand > factor * factor);
+            }
+        }
+        (LabelMap { width: w, height: h, labels }, Mask { width: w, height: h, values: hands })
     }
 }

@@ -4,9 +4,8 @@ use serde::Serialize;
 
 use mannequin_data::rng::SplitMix64;
 
-/// The clothing variants. Offsets on the body make shirts and trousers; skirts and dresses add a
-/// separate skirt surface that bridges the legs, so the body model alone cannot explain the
-/// silhouette.
+/// The clothing variants, each a few garments of the library (see [`Outfit::garments`]); the
+/// skirt and the dress bridge the legs, so the body model alone cannot explain the silhouette.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Outfit {

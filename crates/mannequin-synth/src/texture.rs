@@ -44,6 +44,12 @@ impl SurfacePoint {
     }
 }
 
+/// Hermite smoothstep from 0 at `a` to 1 at `b`.
+pub fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 /// A hash of integer cell coordinates to [0, 1).
 fn cell_hash(x: i32, y: i32, z: i32, salt: u64) -> f32 {
     let h = mix((x as u64).wrapping_mul(0x9E37_79B9)
