@@ -1,11 +1,14 @@
 //! A small synthetic subject from the decimated default body, read back with the dataset
 //! reader and checked for internal consistency: depth against the ground-truth mesh, poses
-//! against the body model, determinism in the seed.
+//! against the body model, each garment's mesh against the whole, label maps against the masks,
+//! determinism in the seed.
 
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use mannequin_body::{BodyModel, forward};
+use mannequin_data::labels::LabelMap;
+use mannequin_data::maps::read_mask_npy;
 use mannequin_data::metrics::surface_distance::TriangleBvh;
 use mannequin_data::{Dataset, layout};
 use mannequin_synth::{SynthOptions, generate};
@@ -69,6 +72,14 @@ fn synthetic_subject_is_a_consistent_dataset() {
     assert_eq!(Dataset::open(root.join("test/novel_view"), 1).unwrap().frame_count, 2 * 3);
     assert_eq!(Dataset::open(root.join("test/novel_pose"), 1).unwrap().frame_count, 2 * 4);
 
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(root.join("subject.json")).unwrap()).unwrap();
+    let legend: Vec<&str> =
+        summary["labels"].as_array().unwrap().iter().map(|l| l.as_str().unwrap()).collect();
+    assert_eq!(legend[..4], ["background", "skin", "hair", "shoes"]);
+    let garments = &legend[4..];
+    assert!(!garments.is_empty());
+    let mut seen = vec![false; garments.len()];
     for (i, &f) in train.frames.iter().enumerate() {
         let frame = ds.frame(f).unwrap();
         let mesh = ds.mesh(f).unwrap().unwrap().mesh;
@@ -99,8 +110,8 @@ fn synthetic_subject_is_a_consistent_dataset() {
             }
         }
         assert!(worst < 1e-4, "frame {f}: depth is {worst} m off the mesh");
-        // The body model with the stored parameters lies under the clothes: every body vertex
-        // of the GT mesh is the naked vertex pushed out by at most a few centimetres.
+        // The body of the GT mesh is the body model with the stored parameters (the clothes are
+        // meshes of their own, after it).
         let poses = &train.poses;
         let t = poses.transl[i];
         let naked = forward(&model, &poses.betas[..model.num_betas().min(10)], &poses.pose72(i), &t).unwrap();
@@ -110,9 +121,30 @@ fn synthetic_subject_is_a_consistent_dataset() {
             let gt = DVec3::from(mesh.positions[v].map(f64::from));
             max_offset = max_offset.max(gt.distance(DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)));
         }
-        assert!(max_offset < 0.06, "frame {f}: clothing offset up to {max_offset} m");
+        assert!(max_offset < 1e-4, "frame {f}: the body is {max_offset} m off the body model");
+        // One sample per pixel: the background label is exactly the mask's outside, and a hand
+        // shows as skin.
+        let labels = LabelMap::read_png(&root.join(format!("labels/label_{f:04}.png"))).unwrap();
+        let hands = read_mask_npy(&root.join(format!("hands/hand_{f:04}.npy"))).unwrap();
+        for (p, &label) in labels.labels.iter().enumerate() {
+            assert_eq!(label != 0, frame.mask.values[p], "frame {f}, pixel {p}");
+            assert!(!hands.values[p] || label == 1, "frame {f}: a hand pixel labelled {label}");
+        }
+        assert!(hands.count() > 0, "frame {f}: no hand shows");
+        // Each garment's own mesh is its part of the whole, after the body and the layers under it.
+        let mut start = body.len() / 3;
+        for (k, name) in garments.iter().enumerate() {
+            let path = root.join(format!("meshes/garment_{name}_{f:04}.ply"));
+            let garment = mannequin_mesh::ply::read(&path).unwrap().mesh;
+            let n = garment.positions.len();
+            assert_eq!(garment.positions[..], mesh.positions[start..start + n], "{name} at frame {f}");
+            start += n;
+            seen[k] |= labels.labels.contains(&(4 + k as u8));
+        }
+        assert_eq!(start, mesh.positions.len(), "frame {f}: the garments are the rest of the mesh");
         assert!(mesh.positions.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min).abs() < 1e-4);
     }
+    assert!(seen.iter().all(|&s| s), "every garment shows in some training frame: {garments:?} {seen:?}");
     std::fs::remove_dir_all(root).unwrap();
 }
 
