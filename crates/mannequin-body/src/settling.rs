@@ -2,7 +2,9 @@
 //! on a still body before the body moves, so half the settling holds the rest pose and the other
 //! half eases from rest into the motion's first frame.
 
-use crate::{BodyError, BodyModel, Motion};
+use mannequin_mesh::points;
+
+use crate::{BodyError, BodyModel, Motion, ShapedBody, pose_frames};
 
 /// The body's pose schedule: `settle` frames (at least one) from rest into the motion's first
 /// frame, then the motion. Frame 0 is the rest pose.
@@ -42,6 +44,16 @@ impl Settling {
 
     pub fn is_empty(&self) -> bool {
         self.trans.is_empty()
+    }
+
+    /// The `shaped` body's vertices at every frame, posed in one pass.
+    pub fn body_frames(
+        &self,
+        model: &BodyModel,
+        shaped: &ShapedBody,
+    ) -> Result<Vec<Vec<[f32; 3]>>, BodyError> {
+        let posed = pose_frames(model, shaped, &self.poses, &self.trans)?;
+        Ok((0..self.len()).map(|k| points(posed.frame_vertices(k))).collect())
     }
 
     /// Frame `k`'s axis-angle pose (3 per joint) and translation.

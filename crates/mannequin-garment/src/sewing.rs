@@ -4,7 +4,7 @@
 use glam::Vec3;
 use mannequin_cloth::Material;
 use mannequin_mesh::TriMesh;
-use mannequin_mesh::adjacency::boundary_loops;
+use mannequin_mesh::adjacency::boundary_loops_by_height;
 
 use crate::drape::drape;
 use crate::error::GarmentError;
@@ -23,18 +23,15 @@ pub fn sew_skirt(
     material: &Material,
     body: &TriMesh,
 ) -> Result<TriMesh, GarmentError> {
-    let points =
-        |l: &[u32]| -> Vec<Vec3> { l.iter().map(|&v| Vec3::from(top.positions[v as usize])).collect() };
-    let height = |l: &[u32]| points(l).iter().map(|p| p.y).sum::<f32>() / l.len() as f32;
     let mut seam =
-        boundary_loops(&top.faces).into_iter().min_by(|a, b| height(a).total_cmp(&height(b))).ok_or_else(
-            || GarmentError::invalid("fit", "the part above the seat has no hem to sew a panel to"),
-        )?;
+        boundary_loops_by_height(&top.positions, &top.faces).into_iter().next().ok_or_else(|| {
+            GarmentError::invalid("fit", "the part above the seat has no hem to sew a panel to")
+        })?;
     // Ordered from +x towards +z about the vertical through the loop's centre, starting at
     // centre back (−z), as the panel expects.
-    let centre = points(&seam).iter().copied().sum::<Vec3>() / seam.len() as f32;
+    let mut loop_points: Vec<Vec3> = seam.iter().map(|&v| Vec3::from(top.positions[v as usize])).collect();
+    let centre = loop_points.iter().copied().sum::<Vec3>() / seam.len() as f32;
     let around = |p: Vec3| Vec3::new(p.x - centre.x, 0.0, p.z - centre.z);
-    let loop_points = points(&seam);
     let turning: f32 = (0..seam.len())
         .map(|i| {
             let (a, b) = (around(loop_points[i]), around(loop_points[(i + 1) % seam.len()]));
@@ -43,17 +40,16 @@ pub fn sew_skirt(
         .sum();
     if turning < 0.0 {
         seam.reverse();
+        loop_points.reverse();
     }
+    let towards_back = |p: &Vec3| -around(*p).normalize_or_zero().z;
     let back = (0..seam.len())
-        .max_by(|&i, &j| {
-            let towards_back =
-                |k: usize| -around(Vec3::from(top.positions[seam[k] as usize])).normalize_or_zero().z;
-            towards_back(i).total_cmp(&towards_back(j))
-        })
+        .max_by(|&i, &j| towards_back(&loop_points[i]).total_cmp(&towards_back(&loop_points[j])))
         .unwrap_or(0);
     seam.rotate_left(back);
+    loop_points.rotate_left(back);
     let body_points: Vec<Vec3> = body.positions.iter().map(|&p| Vec3::from(p)).collect();
-    let panel = hang_panel(&points(&seam), depth, flare, edge, &body_points, CLEARANCE);
+    let panel = hang_panel(&loop_points, depth, flare, edge, &body_points, CLEARANCE);
     let draped = drape(&panel, material, body)?;
     let n = top.positions.len() as u32;
     let sewn = |v: u32| if (v as usize) < panel.seam { seam[v as usize] } else { v - panel.seam as u32 + n };

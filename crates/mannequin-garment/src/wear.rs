@@ -6,7 +6,7 @@
 use mannequin_body::Settling;
 use mannequin_cloth::{Attachment, Body, Cloth, Material, PhaseTimes, Settings, Simulator};
 use mannequin_mesh::TriMesh;
-use mannequin_mesh::adjacency::boundary_loops;
+use mannequin_mesh::adjacency::boundary_loops_by_height;
 
 use crate::collider::Collider;
 use crate::error::GarmentError;
@@ -112,7 +112,5 @@ fn simulate_layer(
 
 /// The vertices of the boundary loop whose mean height at rest is greatest.
 fn waist_loop(mesh: &TriMesh) -> Vec<u32> {
-    let height =
-        |l: &Vec<u32>| l.iter().map(|&v| mesh.positions[v as usize][1]).sum::<f32>() / l.len() as f32;
-    boundary_loops(&mesh.faces).into_iter().max_by(|a, b| height(a).total_cmp(&height(b))).unwrap_or_default()
+    boundary_loops_by_height(&mesh.positions, &mesh.faces).pop().unwrap_or_default()
 }

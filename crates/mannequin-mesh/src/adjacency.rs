@@ -44,6 +44,15 @@ pub fn face_neighbors(faces: &[[u32; 3]]) -> Vec<[Option<u32>; 3]> {
     neighbors
 }
 
+/// The boundary loops of the manifold mesh `positions`/`faces`, lowest mean height (y) first:
+/// a garment's hem first and its waist or neckline last.
+pub fn boundary_loops_by_height(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let height = |l: &Vec<u32>| l.iter().map(|&v| positions[v as usize][1]).sum::<f32>() / l.len() as f32;
+    let mut loops = boundary_loops(faces);
+    loops.sort_by(|a, b| height(a).total_cmp(&height(b)));
+    loops
+}
+
 /// The boundary loops of a manifold mesh: each a cycle of vertices following the faces' winding
 /// along edges that only one face has. A vertex where two loops touch starts a new loop at its
 /// second outgoing edge.
@@ -120,6 +129,22 @@ mod tests {
         assert!(loops[0].iter().all(|&v| v < 4) && loops[1].iter().all(|&v| v >= 4));
         assert_eq!(loops[0], vec![0, 1, 2, 3]);
         assert_eq!(loops[1], vec![4, 7, 6, 5]);
+    }
+
+    /// The same tube with its ring of vertices 4–7 below the ring 0–3: that ring comes first.
+    #[test]
+    fn loops_by_height_put_the_lowest_first() {
+        let mut f = Vec::new();
+        for k in 0..4u32 {
+            let (a, b) = (k, (k + 1) % 4);
+            f.push([a, b, b + 4]);
+            f.push([a, b + 4, a + 4]);
+        }
+        let positions: Vec<[f32; 3]> =
+            (0..8).map(|v| [v as f32, if v < 4 { 1.0 } else { -1.0 }, 0.0]).collect();
+        let loops = boundary_loops_by_height(&positions, &f);
+        assert_eq!(loops.len(), 2);
+        assert!(loops[0].iter().all(|&v| v >= 4) && loops[1].iter().all(|&v| v < 4), "{loops:?}");
     }
 
     #[test]

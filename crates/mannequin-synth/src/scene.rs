@@ -8,7 +8,6 @@ use mannequin_cloth::Settings;
 use mannequin_garment::{Dressed, GarmentError, Wearer, wear};
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::{TriMesh, UvLayout, points};
-use rayon::prelude::*;
 
 use crate::subject::Subject;
 use crate::texture::{BakeInput, SurfacePoint, bake, smoothstep};
@@ -310,13 +309,7 @@ impl Scene {
             gender: None,
         };
         let schedule = Settling::new(model, &motion, SETTLE_SECONDS)?;
-        let body_frames: Vec<Vec<[f32; 3]>> = (0..schedule.len())
-            .into_par_iter()
-            .map(|k| {
-                let (pose, trans) = schedule.pose(k);
-                Ok(points(pose_frames(model, &self.shaped, pose, trans)?.frame_vertices(0)))
-            })
-            .collect::<Result<_, DataError>>()?;
+        let body_frames = schedule.body_frames(model, &self.shaped)?;
         let fail = |e: GarmentError| DataError::Invalid(format!("dressing the subject: {e}"));
         let dressed: Vec<Dressed> = self
             .worn

@@ -8,13 +8,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
-use mannequin_body::{BodyModel, Settling, pose_frames, shape_body, skeletal_animation, skinned_body};
+use mannequin_body::{BodyModel, Settling, shape_body, skeletal_animation, skinned_body};
 use mannequin_cloth::{Material, Settings, quality};
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{
     Category, Dressed, Fit, Garment, SIZE_NAMES, TEMPLATE_REVISION, Wearer, make_garment, wear,
 };
-use mannequin_mesh::{MorphSequence, PointCache, points, write_scene_glb};
+use mannequin_mesh::{MorphSequence, PointCache, write_scene_glb};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -135,12 +135,7 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let schedule = Settling::new(&model, &motion, args.settle)?;
     let shaped = shape_body(&model, betas)?;
-    let body_frames: Vec<Vec<[f32; 3]>> = (0..schedule.len())
-        .map(|k| {
-            let (pose, trans) = schedule.pose(k);
-            Ok(points(pose_frames(&model, &shaped, pose, trans)?.frame_vertices(0)))
-        })
-        .collect::<Result<_>>()?;
+    let body_frames = schedule.body_frames(&model, &shaped)?;
     stage("body", start);
 
     let start = Instant::now();
