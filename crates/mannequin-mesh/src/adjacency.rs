@@ -114,14 +114,14 @@ mod tests {
 
     /// A quad strip closed into a ring (a tube of 4 × 1 quads) has two boundary loops of 4,
     /// running in opposite directions around the tube.
+    /// A square tube of two rings, vertices 0–3 and 4–7.
+    fn tube() -> Vec<[u32; 3]> {
+        (0..4u32).flat_map(|a| [[a, (a + 1) % 4, (a + 1) % 4 + 4], [a, (a + 1) % 4 + 4, a + 4]]).collect()
+    }
+
     #[test]
     fn a_tube_has_two_boundary_loops() {
-        let mut f = Vec::new();
-        for k in 0..4u32 {
-            let (a, b) = (k, (k + 1) % 4);
-            f.push([a, b, b + 4]);
-            f.push([a, b + 4, a + 4]);
-        }
+        let f = tube();
         let mut loops = boundary_loops(&f);
         loops.sort();
         assert_eq!(loops.len(), 2);
@@ -134,12 +134,7 @@ mod tests {
     /// The same tube with its ring of vertices 4–7 below the ring 0–3: that ring comes first.
     #[test]
     fn loops_by_height_put_the_lowest_first() {
-        let mut f = Vec::new();
-        for k in 0..4u32 {
-            let (a, b) = (k, (k + 1) % 4);
-            f.push([a, b, b + 4]);
-            f.push([a, b + 4, a + 4]);
-        }
+        let f = tube();
         let positions: Vec<[f32; 3]> =
             (0..8).map(|v| [v as f32, if v < 4 { 1.0 } else { -1.0 }, 0.0]).collect();
         let loops = boundary_loops_by_height(&positions, &f);
