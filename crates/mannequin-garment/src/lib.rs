@@ -23,4 +23,4 @@ pub use fit::{Fit, SIZE_NAMES};
 pub use garment::{Garment, Recipe};
 pub use make::{TEMPLATE_REVISION, make_garment};
 pub use transfer::Dressed;
-pub use wear::{Wearer, WornLayer, wear};
+pub use wear::{LayerProgress, WearProgress, WearStep, Wearer, WornLayer, wear};

@@ -1,10 +1,11 @@
 //! Wearing garments through a motion: each layer, inner first, simulated by XPBD from its
 //! transferred rest shape (Eq. 3.2) through the pose schedule, colliding with the body and with
 //! every layer under it. Skinning (Eq. 3.3) says where the layer goes; the simulator resolves
-//! what skinning cannot, gravity on loose parts and the body pushing through.
+//! what skinning cannot, gravity on loose parts and the body pushing through. A wear reports
+//! each frame with what a checkpoint needs, and resumes from such a checkpoint bit for bit.
 
 use mannequin_body::Settling;
-use mannequin_cloth::{Attachment, Body, Cloth, Material, PhaseTimes, Settings, Simulator};
+use mannequin_cloth::{Attachment, Body, Cloth, ClothState, Material, PhaseTimes, Settings, Simulator};
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::adjacency::boundary_loops_by_height;
 
@@ -25,49 +26,140 @@ pub struct Wearer<'a> {
     pub fps: f32,
 }
 
-/// One layer simulated: its positions at every frame of the schedule, and where the time went.
+/// One layer simulated: its positions at every frame of the schedule, and where the time went
+/// (since the wear resumed, for a resumed layer).
 pub struct WornLayer {
     pub frames: Vec<Vec<[f32; 3]>>,
     pub phases: PhaseTimes,
 }
 
-/// Simulates `layers` (named, inner first) on `wearer` with the solver's `settings`;
-/// `on_frame(layer)` is called after each simulated frame.
-pub fn wear(
+/// How far a wear has got: every frame of the layers finished (inner first), and of the layer
+/// under way with the simulator's state after its last frame. What a checkpoint holds.
+#[derive(Debug, Clone, Default)]
+pub struct WearProgress {
+    pub finished: Vec<Vec<Vec<[f32; 3]>>>,
+    pub current: Option<LayerProgress>,
+}
+
+/// The layer under way: its frames so far (from the schedule's first) and the cloth's state.
+#[derive(Debug, Clone)]
+pub struct LayerProgress {
+    pub frames: Vec<Vec<[f32; 3]>>,
+    pub state: ClothState,
+}
+
+/// What a wear reports after each simulated frame.
+pub struct WearStep<'a> {
+    /// The layer just stepped (inner first).
+    pub layer: usize,
+    finished: &'a [WornLayer],
+    frames: &'a [Vec<[f32; 3]>],
+    sim: &'a Simulator,
+}
+
+impl WearStep<'_> {
+    /// Frames simulated so far over all layers, settling included (each layer's first frame is
+    /// its rest shape and is not simulated).
+    pub fn frames_done(&self) -> usize {
+        self.finished.iter().map(|l| l.frames.len() - 1).sum::<usize>() + self.frames.len() - 1
+    }
+
+    /// A copy of the progress so far, to save as a checkpoint.
+    pub fn progress(&self) -> WearProgress {
+        WearProgress {
+            finished: self.finished.iter().map(|l| l.frames.clone()).collect(),
+            current: Some(LayerProgress { frames: self.frames.to_vec(), state: self.sim.state() }),
+        }
+    }
+}
+
+/// Simulates `layers` (named, inner first) on `wearer` with the solver's `settings`, going on
+/// from `resume` (a default one starts afresh); `on_frame` is called after each simulated frame
+/// (to save a checkpoint, say) and its error stops the wear.
+pub fn wear<E: From<GarmentError>>(
     layers: &[(&str, &Dressed)],
     wearer: &Wearer,
     settings: Settings,
-    on_frame: &(dyn Fn(usize) + Sync),
-) -> Result<Vec<WornLayer>, GarmentError> {
-    let mut worn: Vec<WornLayer> = Vec::with_capacity(layers.len());
-    for (i, (name, dressed)) in layers.iter().enumerate() {
+    resume: WearProgress,
+    on_frame: &mut dyn FnMut(&WearStep) -> Result<(), E>,
+) -> Result<Vec<WornLayer>, E> {
+    check_progress(&resume, layers, wearer.frames.len())?;
+    let mut worn: Vec<WornLayer> = resume
+        .finished
+        .into_iter()
+        .map(|frames| WornLayer { frames, phases: PhaseTimes::default() })
+        .collect();
+    let mut current = resume.current;
+    for (i, (name, dressed)) in layers.iter().enumerate().skip(worn.len()) {
         let inner: Vec<Layer> = layers
             .iter()
             .zip(&worn)
             .map(|((_, d), w)| (d.garment().mesh.faces.as_slice(), w.frames.as_slice()))
             .collect();
-        let layer = simulate_layer(name, dressed, &inner, wearer, settings, &|| on_frame(i))?;
+        let mut report = |frames: &[Vec<[f32; 3]>], sim: &Simulator| {
+            on_frame(&WearStep { layer: i, finished: &worn, frames, sim })
+        };
+        let layer = simulate_layer(name, dressed, &inner, wearer, settings, current.take(), &mut report)?;
         worn.push(layer);
     }
     Ok(worn)
 }
 
-/// One layer through the whole schedule (settling included). Lower-body garments are held at
-/// the waist (the loop of their boundary that is highest at rest), as an elastic waistband
-/// holds them.
-fn simulate_layer(
+/// Refuses progress that is not of these layers on this schedule, naming the field at fault.
+fn check_progress(
+    progress: &WearProgress,
+    layers: &[(&str, &Dressed)],
+    schedule: usize,
+) -> Result<(), GarmentError> {
+    let under_way = usize::from(progress.current.is_some());
+    if progress.finished.len() + under_way > layers.len() {
+        return Err(GarmentError::invalid(
+            "progress.finished",
+            format!(
+                "{} layers finished and {under_way} under way, but {} are worn",
+                progress.finished.len(),
+                layers.len()
+            ),
+        ));
+    }
+    let current = progress.current.iter().map(|c| ("current", &c.frames, 1..schedule));
+    let finished = progress.finished.iter().map(|f| ("finished", f, schedule..schedule + 1));
+    for ((field, frames, expected), (_, dressed)) in finished.chain(current).zip(layers) {
+        let vertices = dressed.garment().vertex_count();
+        if !expected.contains(&frames.len()) || frames.iter().any(|f| f.len() != vertices) {
+            return Err(GarmentError::invalid(
+                format!("progress.{field}"),
+                format!(
+                    "expected {expected:?} frames of {vertices} vertices ({}), found {} frames",
+                    dressed.garment().recipe.category.name(),
+                    frames.len()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Called after each frame of a layer with its frames so far and the simulator.
+type LayerReport<'a, E> = dyn FnMut(&[Vec<[f32; 3]>], &Simulator) -> Result<(), E> + 'a;
+
+/// One layer through the whole schedule (settling included), or its rest from `resume`. Lower-
+/// body garments are held at the waist (the loop of their boundary that is highest at rest), as
+/// an elastic waistband holds them.
+fn simulate_layer<E: From<GarmentError>>(
     name: &str,
     dressed: &Dressed,
     inner: &[Layer],
     wearer: &Wearer,
     settings: Settings,
-    on_frame: &dyn Fn(),
-) -> Result<WornLayer, GarmentError> {
+    resume: Option<LayerProgress>,
+    on_frame: &mut LayerReport<E>,
+) -> Result<WornLayer, E> {
     let garment = dressed.garment();
     let rest = dressed.rest();
     let mut mesh = garment.mesh.clone();
     mesh.positions = rest.clone();
-    let material = Material::named(&garment.recipe.material)?;
+    let material = Material::named(&garment.recipe.material).map_err(GarmentError::from)?;
     let failed =
         |when: String| move |source| GarmentError::Simulation { garment: name.to_string(), when, source };
     let cloth = Cloth::new(&mesh, &material, &[]).map_err(failed("at rest".into()))?;
@@ -94,9 +186,15 @@ fn simulate_layer(
     let mut sim = Simulator::new(cloth, Some(Body::new(faces)), attachments, settings)
         .map_err(failed("at rest".into()))?;
     let settle = wearer.schedule.settle;
-    let mut frames = vec![rest];
-    let mut previous = at_rest;
-    for k in 1..wearer.frames.len() {
+    let mut frames = match resume {
+        Some(progress) => {
+            sim.restore(progress.state).map_err(failed("resuming".into()))?;
+            progress.frames
+        }
+        None => vec![rest],
+    };
+    let mut previous = collider.at(frames.len() - 1);
+    for k in frames.len()..wearer.frames.len() {
         let next = collider.at(k);
         sim.step_frame(&previous, &next, 1.0 / wearer.fps).map_err(failed(if k < settle {
             "while settling".into()
@@ -105,7 +203,7 @@ fn simulate_layer(
         }))?;
         frames.push(sim.positions().to_vec());
         previous = next;
-        on_frame();
+        on_frame(&frames, &sim)?;
     }
     Ok(WornLayer { frames, phases: sim.phase_times() })
 }

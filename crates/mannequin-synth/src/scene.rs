@@ -5,7 +5,7 @@
 use glam::{DVec3, Vec3};
 use mannequin_body::{BodyModel, Motion, Settling, ShapedBody, pose_frames, shape_body};
 use mannequin_cloth::Settings;
-use mannequin_garment::{Dressed, GarmentError, Wearer, wear};
+use mannequin_garment::{Dressed, GarmentError, WearProgress, Wearer, wear};
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::{TriMesh, UvLayout, points};
 
@@ -321,7 +321,9 @@ impl Scene {
         let wearer = Wearer { faces: &self.body_faces, frames: &body_frames, schedule: &schedule, fps };
         let substeps = (SUBSTEPS_PER_SECOND / fps).ceil() as u32;
         let settings = Settings { substeps, self_collision: false, ..Settings::default() };
-        let layers = wear(&named, &wearer, settings, &|_| ()).map_err(fail)?;
+        let layers =
+            wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |_| Ok(()))
+                .map_err(fail)?;
         let vertices = (schedule.settle..schedule.len())
             .map(|k| {
                 let mut all = body_frames[k].clone();

@@ -19,6 +19,9 @@ use mannequin_mesh::{MorphSequence, PointCache, TriMesh, points, read_obj, write
 use serde::Serialize;
 
 use crate::body::{BodyArgs, load_body};
+use crate::checkpoint::{
+    CHECKPOINT, add_run, add_state, check_run, file_hash, frames_array, read_frames, read_state,
+};
 use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
 
@@ -114,12 +117,6 @@ struct ClothRun {
     self_collision: bool,
 }
 
-/// The hash of a file's bytes: tells an edited input from the one a checkpoint ran.
-fn file_hash(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    Ok(mannequin_data::fingerprint::hash_bytes(&bytes))
-}
-
 /// Per-frame quality of the simulated garment.
 #[derive(Debug, Clone, Serialize, serde::Deserialize)]
 struct FrameMetrics {
@@ -138,18 +135,12 @@ struct Progress {
     metrics: Vec<FrameMetrics>,
 }
 
-const CHECKPOINT: &str = "checkpoint.npz";
-
 fn write_checkpoint(path: &Path, run: &ClothRun, state: &ClothState, progress: &Progress) -> Result<()> {
-    let v = state.positions.len();
-    let flat = |p: &[[f32; 3]]| p.iter().flatten().copied().collect::<Vec<f32>>();
     let mut w = NpzWriter::new();
-    w.add("run", NpyArray::text(&serde_json::to_string(run)?));
+    add_run(&mut w, run)?;
     w.add("next", NpyArray::i64(vec![1], vec![progress.next as i64]));
-    w.add("positions", NpyArray::f32(vec![v, 3], flat(&state.positions)));
-    w.add("velocities", NpyArray::f32(vec![v, 3], flat(&state.velocities)));
-    let recorded: Vec<f32> = progress.frames.iter().flat_map(|f| flat(f)).collect();
-    w.add("frames", NpyArray::f32(vec![progress.frames.len(), v, 3], recorded));
+    add_state(&mut w, state);
+    w.add("frames", frames_array(&progress.frames, state.positions.len()));
     w.add("metrics", NpyArray::text(&serde_json::to_string(&progress.metrics)?));
     w.write(path)?;
     Ok(())
@@ -159,36 +150,11 @@ fn write_checkpoint(path: &Path, run: &ClothRun, state: &ClothState, progress: &
 /// differ if it is another run's.
 fn read_checkpoint(path: &Path, run: &ClothRun, vertices: usize) -> Result<(Progress, ClothState)> {
     let npz = Npz::read(path)?;
-    let recorded: ClothRun = serde_json::from_str(npz.text("run")?)
-        .with_context(|| format!("{}: run: expected the run's settings as JSON", path.display()))?;
-    if &recorded != run {
-        let (was, now) = (serde_json::to_value(&recorded)?, serde_json::to_value(run)?);
-        let differ: Vec<String> = now
-            .as_object()
-            .into_iter()
-            .flatten()
-            .filter(|(k, v)| was.get(k.as_str()) != Some(v))
-            .map(|(k, v)| format!("{k} was {}, now {v}", was[k.as_str()]))
-            .collect();
-        bail!(
-            "{}: a checkpoint of another run: {}; use --restart to start over, or another --out",
-            path.display(),
-            differ.join(", ")
-        );
-    }
-    let array = |key: &str, shape: &[Option<usize>]| -> Result<Vec<f32>> {
-        Ok(npz.f64_with_shape(key, shape)?.1.into_iter().map(|x| x as f32).collect())
-    };
+    check_run(&npz, path, run)?;
     let next = npz.require("next")?.to_i64().and_then(|n| n.first().copied()).unwrap_or(-1);
     let next = usize::try_from(next).map_err(|_| npz.field_error("next", "a frame number"))?;
-    let state = ClothState {
-        positions: points(&array("positions", &[Some(vertices), Some(3)])?),
-        velocities: points(&array("velocities", &[Some(vertices), Some(3)])?),
-    };
-    let frames = array("frames", &[None, Some(vertices), Some(3)])?
-        .chunks_exact((3 * vertices).max(1))
-        .map(points)
-        .collect();
+    let state = read_state(&npz, vertices)?;
+    let frames = read_frames(&npz, "frames", vertices)?;
     let metrics = serde_json::from_str(npz.text("metrics")?)
         .with_context(|| format!("{}: metrics: expected the per-frame metrics as JSON", path.display()))?;
     Ok((Progress { next, frames, metrics }, state))

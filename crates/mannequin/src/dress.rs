@@ -12,13 +12,18 @@ use mannequin_body::{BodyModel, Settling, shape_body, skeletal_animation, skinne
 use mannequin_cloth::{Material, Settings, quality};
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{
-    Category, Dressed, Fit, Garment, SIZE_NAMES, TEMPLATE_REVISION, Wearer, make_garment, wear,
+    Category, Dressed, Fit, Garment, LayerProgress, SIZE_NAMES, TEMPLATE_REVISION, WearProgress, WearStep,
+    Wearer, make_garment, wear,
 };
+use mannequin_io::{Npz, NpzWriter};
 use mannequin_mesh::{MorphSequence, PointCache, write_scene_glb};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::body::{BodyArgs, load_body};
+use crate::checkpoint::{
+    CHECKPOINT, add_run, add_state, check_run, file_hash, frames_array, read_frames, read_state,
+};
 use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
 
@@ -66,6 +71,13 @@ pub struct Args {
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
+    /// Save a checkpoint every this many simulated frames (0: never); a re-run of the same
+    /// command goes on from it.
+    #[arg(long, default_value_t = 60)]
+    checkpoint_every: usize,
+    /// Start over even if the folder holds a checkpoint.
+    #[arg(long)]
+    restart: bool,
 }
 
 /// How far (m) each layer stands beyond the one under it at rest: twice the simulator's body
@@ -138,6 +150,11 @@ pub fn run(args: Args) -> Result<()> {
     let body_frames = schedule.body_frames(&model, &shaped)?;
     stage("body", start);
 
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let checkpoint = args.out.join(CHECKPOINT);
+    if args.restart {
+        std::fs::remove_file(&checkpoint).ok();
+    }
     let start = Instant::now();
     let layers: Vec<Vec<Vec<[f32; 3]>>> = if args.no_simulation {
         worn.iter()
@@ -156,8 +173,35 @@ pub fn run(args: Args) -> Result<()> {
             Wearer { faces: &body_faces, frames: &body_frames, schedule: &schedule, fps: motion.fps };
         let settings =
             Settings { substeps: args.substeps, self_collision: args.self_collision, ..Settings::default() };
-        let progress = bar((worn.len() * (schedule.len() - 1)) as u64, "simulation");
-        let simulated = wear(&named, &wearer, settings, &|_| progress.inc(1))?;
+        let run = DressRun {
+            garments: worn.iter().map(|w| format!("{} {}", w.name, template_hash(w.garment))).collect(),
+            body: args.body.body.clone(),
+            betas: betas.clone(),
+            motion: file_hash(&args.clip.motion)?,
+            fps: motion.fps,
+            frames: motion.num_frames(),
+            substeps: args.substeps,
+            settle: args.settle,
+            self_collision: args.self_collision,
+        };
+        let resume = if checkpoint.exists() {
+            let resume = read_checkpoint(&checkpoint, &run, &worn)?;
+            tracing::info!("resuming {}", checkpoint.display());
+            resume
+        } else {
+            WearProgress::default()
+        };
+        let total = worn.len() * (schedule.len() - 1);
+        let progress = bar(total as u64, "simulation");
+        let mut on_frame = |step: &WearStep| -> Result<()> {
+            let done = step.frames_done();
+            progress.set_position(done as u64);
+            if args.checkpoint_every > 0 && done.is_multiple_of(args.checkpoint_every) && done < total {
+                write_checkpoint(&checkpoint, &run, &step.progress(), &worn)?;
+            }
+            Ok(())
+        };
+        let simulated = wear(&named, &wearer, settings, resume, &mut on_frame)?;
         progress.finish_and_clear();
         simulated
             .into_iter()
@@ -258,7 +302,6 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     stage("metrics", start);
 
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let start = Instant::now();
     if !args.no_frames {
         let meshes: Vec<(&[[u32; 3]], [f32; 3])> = worn
@@ -279,7 +322,73 @@ pub fn run(args: Args) -> Result<()> {
         layers.iter().map(|l| l[motion_frames.clone()].to_vec()).collect();
     write_scene(&args.out, &model, betas, &motion, &worn, &motion_layers)?;
     stage("write", start);
-    write_metrics(&args.out, &worn, &metrics, motion.fps, stage_s)
+    write_metrics(&args.out, &worn, &metrics, motion.fps, stage_s)?;
+    if !args.no_simulation {
+        std::fs::remove_file(&checkpoint).ok();
+    }
+    Ok(())
+}
+
+/// Everything that changes the simulation; a checkpoint of another run is refused.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+struct DressRun {
+    /// Each layer's name and template hash, inner first.
+    garments: Vec<String>,
+    body: String,
+    betas: Vec<f32>,
+    motion: String,
+    fps: f32,
+    frames: usize,
+    substeps: u32,
+    settle: f32,
+    self_collision: bool,
+}
+
+/// The hash of what a template brings to a run: recipe, mesh and binding to the body.
+fn template_hash(g: &Garment) -> String {
+    let mut bytes = serde_json::to_vec(&g.recipe).unwrap_or_default();
+    let floats =
+        g.mesh.positions.iter().chain(&g.offsets).flatten().chain(g.binding.iter().flat_map(|b| &b.bary));
+    bytes.extend(floats.flat_map(|x| x.to_le_bytes()));
+    let indices = g.mesh.faces.iter().flatten().chain(g.binding.iter().map(|b| &b.face));
+    bytes.extend(indices.flat_map(|i| i.to_le_bytes()));
+    mannequin_data::fingerprint::hash_bytes(&bytes)
+}
+
+/// Finished layers as `finished_<i>`, the one under way as `current` with the cloth's state.
+fn write_checkpoint(path: &Path, run: &DressRun, progress: &WearProgress, worn: &[Worn]) -> Result<()> {
+    let mut w = NpzWriter::uncompressed();
+    add_run(&mut w, run)?;
+    for (i, (frames, layer)) in progress.finished.iter().zip(worn).enumerate() {
+        w.add(&format!("finished_{i}"), frames_array(frames, layer.garment.vertex_count()));
+    }
+    if let (Some(current), Some(layer)) = (&progress.current, worn.get(progress.finished.len())) {
+        w.add("current", frames_array(&current.frames, layer.garment.vertex_count()));
+        add_state(&mut w, &current.state);
+    }
+    w.write(path)?;
+    Ok(())
+}
+
+/// The progress a checkpoint of `run` holds; an error naming what differs for another run's.
+fn read_checkpoint(path: &Path, run: &DressRun, worn: &[Worn]) -> Result<WearProgress> {
+    let npz = Npz::read(path)?;
+    check_run(&npz, path, run)?;
+    let mut progress = WearProgress::default();
+    for (i, layer) in worn.iter().enumerate() {
+        let vertices = layer.garment.vertex_count();
+        let key = format!("finished_{i}");
+        if npz.contains(&key) {
+            progress.finished.push(read_frames(&npz, &key, vertices)?);
+        } else {
+            if npz.contains("current") {
+                let frames = read_frames(&npz, "current", vertices)?;
+                progress.current = Some(LayerProgress { frames, state: read_state(&npz, vertices)? });
+            }
+            break;
+        }
+    }
+    Ok(progress)
 }
 
 /// A `.garment` file, or a category name made at `size` on this body and cached under

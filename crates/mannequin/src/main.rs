@@ -3,6 +3,7 @@
 
 mod animate;
 mod body;
+mod checkpoint;
 mod cloth;
 mod compute;
 mod demo;

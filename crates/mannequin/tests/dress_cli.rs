@@ -119,3 +119,55 @@ fn pants_and_a_tshirt_walk_on_five_body_shapes() {
         }
     }
 }
+
+/// A run killed once a checkpoint holds a finished layer and run again with the same command
+/// goes on from it and ends with the same frames, bit for bit, as a run never stopped; a
+/// changed option is refused naming it.
+#[test]
+fn a_killed_dress_resumes_to_the_same_frames() {
+    let dir = scratch("dress_resume");
+    let walk = dir.join("walk.npz");
+    ok(mannequin(&["motion", "walk", "-o", s(&walk), "--seconds", "0.5"]));
+    let cache = dir.join("cache");
+    let run = |out: &Path, extra: &[&str]| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"));
+        command
+            .args(["dress", "--garments", "pants,tshirt", "--motion", s(&walk), "--settle", "0.4"])
+            .args(["--no-frames", "--checkpoint-every", "5", "--out", s(out)])
+            .args(extra)
+            .env("XDG_CACHE_HOME", &cache);
+        command
+    };
+    let whole = dir.join("whole");
+    ok(run(&whole, &[]).output().unwrap());
+
+    let resumed = dir.join("resumed");
+    let mut child = run(&resumed, &[]).stderr(std::process::Stdio::null()).spawn().unwrap();
+    let checkpoint = resumed.join("checkpoint.npz");
+    let holds_a_finished_layer =
+        || mannequin_io::Npz::read(&checkpoint).is_ok_and(|npz| npz.contains("finished_0"));
+    let start = std::time::Instant::now();
+    while !holds_a_finished_layer() && start.elapsed().as_secs() < 300 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(holds_a_finished_layer(), "no checkpoint past the first layer within 5 minutes");
+    assert!(!resumed.join("metrics.json").exists(), "killed before the end");
+
+    let o = run(&resumed, &["--substeps", "10"]).output().unwrap();
+    one_line_error(&o, &["checkpoint.npz", "substeps was 20, now 10", "--restart"]);
+
+    let o = ok(run(&resumed, &[]).output().unwrap());
+    let log = String::from_utf8_lossy(&o.stderr);
+    assert!(log.contains("resuming"), "{log}");
+    assert!(!checkpoint.exists(), "a finished run leaves no checkpoint");
+    for garment in ["pants", "tshirt"] {
+        let read = |d: &Path| std::fs::read(d.join(format!("{garment}.pc2"))).unwrap();
+        assert!(
+            read(&whole) == read(&resumed),
+            "{garment}: resumed frames differ from the uninterrupted run's"
+        );
+    }
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -1,0 +1,78 @@
+//! What the simulating commands' checkpoints share: the run's settings stored beside the state,
+//! so a checkpoint of another run is refused naming what changed, and point arrays in and out.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use mannequin_cloth::ClothState;
+use mannequin_io::{NpyArray, Npz, NpzWriter};
+use mannequin_mesh::points;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+/// The checkpoint's file name in a command's output folder.
+pub const CHECKPOINT: &str = "checkpoint.npz";
+
+/// The hash of a file's bytes: tells an edited input from the one a checkpoint ran.
+pub fn file_hash(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(mannequin_data::fingerprint::hash_bytes(&bytes))
+}
+
+/// Stores `run` (everything that changes the result) as the checkpoint's "run" entry.
+pub fn add_run<T: Serialize>(w: &mut NpzWriter, run: &T) -> Result<()> {
+    w.add("run", NpyArray::text(&serde_json::to_string(run)?));
+    Ok(())
+}
+
+/// Refuses a checkpoint whose "run" entry is not `run`, naming the settings that differ.
+pub fn check_run<T: Serialize + DeserializeOwned + PartialEq>(npz: &Npz, path: &Path, run: &T) -> Result<()> {
+    let recorded: T = serde_json::from_str(npz.text("run")?)
+        .with_context(|| format!("{}: run: expected the run's settings as JSON", path.display()))?;
+    if &recorded == run {
+        return Ok(());
+    }
+    let (was, now) = (serde_json::to_value(&recorded)?, serde_json::to_value(run)?);
+    let differ: Vec<String> = now
+        .as_object()
+        .into_iter()
+        .flatten()
+        .filter(|(k, v)| was.get(k.as_str()) != Some(v))
+        .map(|(k, v)| format!("{k} was {}, now {v}", was[k.as_str()]))
+        .collect();
+    bail!(
+        "{}: a checkpoint of another run: {}; use --restart to start over, or another --out",
+        path.display(),
+        differ.join(", ")
+    )
+}
+
+/// `frames` (each of `vertices` points) as one [frames, vertices, 3] array.
+pub fn frames_array(frames: &[Vec<[f32; 3]>], vertices: usize) -> NpyArray {
+    let flat = frames.iter().flatten().flatten().copied().collect();
+    NpyArray::f32(vec![frames.len(), vertices, 3], flat)
+}
+
+/// The [frames, vertices, 3] array under `key`, checked against `vertices`.
+pub fn read_frames(npz: &Npz, key: &str, vertices: usize) -> Result<Vec<Vec<[f32; 3]>>> {
+    let (_, values) = npz.f64_with_shape(key, &[None, Some(vertices), Some(3)])?;
+    let values: Vec<f32> = values.into_iter().map(|x| x as f32).collect();
+    Ok(values.chunks_exact((3 * vertices).max(1)).map(points).collect())
+}
+
+/// The cloth simulator's state as "positions" and "velocities" [vertices, 3] arrays.
+pub fn add_state(w: &mut NpzWriter, state: &ClothState) {
+    for (key, values) in [("positions", &state.positions), ("velocities", &state.velocities)] {
+        let flat = values.iter().flatten().copied().collect();
+        w.add(key, NpyArray::f32(vec![values.len(), 3], flat));
+    }
+}
+
+/// The state [`add_state`] stored, checked against `vertices`.
+pub fn read_state(npz: &Npz, vertices: usize) -> Result<ClothState> {
+    let read = |key: &str| -> Result<Vec<[f32; 3]>> {
+        let (_, values) = npz.f64_with_shape(key, &[Some(vertices), Some(3)])?;
+        Ok(points(&values.into_iter().map(|x| x as f32).collect::<Vec<_>>()))
+    };
+    Ok(ClothState { positions: read("positions")?, velocities: read("velocities")? })
+}
