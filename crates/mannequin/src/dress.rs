@@ -271,7 +271,7 @@ pub fn run(args: Args) -> Result<()> {
                         quality::edge_strain(&rest, positions, &w.garment.mesh.faces);
                     let crossings_with_inner_layers = (0..i)
                         .map(|j| {
-                            crossings(
+                            quality::crossing_pairs(
                                 positions,
                                 &w.garment.mesh.faces,
                                 &layers[j][k],
@@ -441,17 +441,6 @@ fn cache_dir() -> Option<PathBuf> {
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
         .map(|d| d.join("mannequin"))
-}
-
-/// Triangle pairs of two meshes that cross: the pairs of their union less each one's own.
-fn crossings(a: &[[f32; 3]], a_faces: &[[u32; 3]], b: &[[f32; 3]], b_faces: &[[u32; 3]]) -> usize {
-    let mut positions = a.to_vec();
-    positions.extend_from_slice(b);
-    let n = a.len() as u32;
-    let mut faces = a_faces.to_vec();
-    faces.extend(b_faces.iter().map(|t| t.map(|i| i + n)));
-    let union = quality::self_intersecting_pairs(&positions, &faces);
-    union - quality::self_intersecting_pairs(a, a_faces) - quality::self_intersecting_pairs(b, b_faces)
 }
 
 /// dressed.glb (the skinned body playing the motion, each garment as morph targets in sync)

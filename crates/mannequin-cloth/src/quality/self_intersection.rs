@@ -1,6 +1,7 @@
-//! Counts pairs of triangles of one mesh that intersect, skipping pairs that share a vertex (those
-//! touch by construction). Candidates come from a uniform grid of the triangles' boxes; each
-//! overlapping pair is tested once, in the cell holding the low corner of the boxes' overlap.
+//! Counts pairs of triangles of one mesh, or across two meshes, that intersect, skipping pairs
+//! that share a vertex (those touch by construction). Candidates come from a uniform grid of the
+//! triangles' boxes; each overlapping pair is tested once, in the cell holding the low corner of
+//! the boxes' overlap.
 
 use std::collections::HashMap;
 
@@ -9,15 +10,42 @@ use super::triangle_intersection::{Point, triangles_intersect};
 /// The number of intersecting pairs of triangles with no vertex in common. Faces with an index out
 /// of range are ignored.
 pub fn self_intersecting_pairs(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> usize {
-    let faces: Vec<[u32; 3]> =
-        faces.iter().copied().filter(|f| f.iter().all(|&i| (i as usize) < positions.len())).collect();
+    intersecting_pairs(positions, faces, |_, _| true)
+}
+
+/// The number of pairs of a triangle of mesh `a` and one of mesh `b` that intersect: how often
+/// one layer of cloth passes through another.
+pub fn crossing_pairs(a: &[[f32; 3]], a_faces: &[[u32; 3]], b: &[[f32; 3]], b_faces: &[[u32; 3]]) -> usize {
+    let mut positions = a.to_vec();
+    positions.extend_from_slice(b);
+    let n = a.len() as u32;
+    // Faces of `b` are shifted past `a`'s vertices; one of `a`'s faces out of range must not
+    // reach into `b`, so it is dropped here.
+    let mut faces: Vec<[u32; 3]> = a_faces.iter().copied().filter(|f| f.iter().all(|&i| i < n)).collect();
+    let first_of_b = faces.len();
+    faces.extend(b_faces.iter().map(|t| t.map(|i| i.saturating_add(n))));
+    intersecting_pairs(&positions, &faces, |i, j| (i < first_of_b) != (j < first_of_b))
+}
+
+/// Intersecting pairs of faces `i`, `j` for which `counts(i, j)` holds.
+fn intersecting_pairs(
+    positions: &[[f32; 3]],
+    faces: &[[u32; 3]],
+    counts: impl Fn(usize, usize) -> bool,
+) -> usize {
+    let faces: Vec<(usize, [u32; 3])> = faces
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, f)| f.iter().all(|&i| (i as usize) < positions.len()))
+        .collect();
     if faces.is_empty() {
         return 0;
     }
     let corners = |f: [u32; 3]| -> [Point; 3] { f.map(|i| positions[i as usize].map(f64::from)) };
     let boxes: Vec<(Point, Point)> = faces
         .iter()
-        .map(|&f| {
+        .map(|&(_, f)| {
             let c = corners(f);
             let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
             let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
@@ -49,8 +77,8 @@ pub fn self_intersecting_pairs(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> us
                 if key([0, 1, 2].map(|k| lo_i[k].max(lo_j[k]))) != *cell_key {
                     continue;
                 }
-                let (fi, fj) = (faces[i as usize], faces[j as usize]);
-                if fi.iter().any(|v| fj.contains(v)) {
+                let ((i, fi), (j, fj)) = (faces[i as usize], faces[j as usize]);
+                if !counts(i, j) || fi.iter().any(|v| fj.contains(v)) {
                     continue;
                 }
                 if triangles_intersect(corners(fi), corners(fj)) {
@@ -100,6 +128,44 @@ mod tests {
             .count();
         assert!(brute > 0);
         assert_eq!(self_intersecting_pairs(&positions, &faces), brute);
+    }
+
+    /// Mesh `a` is two squares crossing each other, `b` a third square through one of them: only
+    /// the pairs of a triangle of `a` and one of `b` count, as testing every such pair finds.
+    #[test]
+    fn crossings_count_only_pairs_across_the_meshes() {
+        let square = |origin: [f32; 3], u: [f32; 3], v: [f32; 3], n: usize, positions: &mut Vec<[f32; 3]>| {
+            let base = positions.len() as u32;
+            for j in 0..=n {
+                for i in 0..=n {
+                    let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+                    positions.push([0, 1, 2].map(|k| origin[k] + s * u[k] + t * v[k]));
+                }
+            }
+            let at = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
+            (0..n)
+                .flat_map(|j| {
+                    (0..n).flat_map(move |i| {
+                        [
+                            [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                            [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                        ]
+                    })
+                })
+                .collect::<Vec<_>>()
+        };
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        let mut a_faces = square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 5, &mut a);
+        a_faces.extend(square([0.2, 0.3, -0.5], [0.6, 0.1, 0.0], [0.0, 0.2, 1.0], 4, &mut a));
+        let b_faces = square([0.1, 0.6, -0.3], [0.7, -0.2, 0.1], [0.1, 0.1, 0.9], 3, &mut b);
+        let corners = |p: &[[f32; 3]], f: [u32; 3]| f.map(|k| p[k as usize].map(f64::from));
+        let brute = a_faces
+            .iter()
+            .flat_map(|&fa| b_faces.iter().map(move |&fb| (fa, fb)))
+            .filter(|&(fa, fb)| triangles_intersect(corners(&a, fa), corners(&b, fb)))
+            .count();
+        assert!(brute > 0 && self_intersecting_pairs(&a, &a_faces) > 0);
+        assert_eq!(crossing_pairs(&a, &a_faces, &b, &b_faces), brute);
     }
 
     #[test]
