@@ -55,9 +55,14 @@ pub fn frames_array(frames: &[Vec<[f32; 3]>], vertices: usize) -> NpyArray {
 
 /// The [frames, vertices, 3] array under `key`, checked against `vertices`.
 pub fn read_frames(npz: &Npz, key: &str, vertices: usize) -> Result<Vec<Vec<[f32; 3]>>> {
-    let (_, values) = npz.f64_with_shape(key, &[None, Some(vertices), Some(3)])?;
-    let values: Vec<f32> = values.into_iter().map(|x| x as f32).collect();
-    Ok(values.chunks_exact((3 * vertices).max(1)).map(points).collect())
+    let values = read_points(npz, key, &[None, Some(vertices), Some(3)])?;
+    Ok(values.chunks_exact(vertices.max(1)).map(<[_]>::to_vec).collect())
+}
+
+/// The points of the array under `key`, whose shape must match `shape` (ending in 3).
+fn read_points(npz: &Npz, key: &str, shape: &[Option<usize>]) -> Result<Vec<[f32; 3]>> {
+    let (_, values) = npz.f64_with_shape(key, shape)?;
+    Ok(points(&values.into_iter().map(|x| x as f32).collect::<Vec<_>>()))
 }
 
 /// The cloth simulator's state as "positions" and "velocities" [vertices, 3] arrays.
@@ -70,9 +75,6 @@ pub fn add_state(w: &mut NpzWriter, state: &ClothState) {
 
 /// The state [`add_state`] stored, checked against `vertices`.
 pub fn read_state(npz: &Npz, vertices: usize) -> Result<ClothState> {
-    let read = |key: &str| -> Result<Vec<[f32; 3]>> {
-        let (_, values) = npz.f64_with_shape(key, &[Some(vertices), Some(3)])?;
-        Ok(points(&values.into_iter().map(|x| x as f32).collect::<Vec<_>>()))
-    };
+    let read = |key: &str| read_points(npz, key, &[Some(vertices), Some(3)]);
     Ok(ClothState { positions: read("positions")?, velocities: read("velocities")? })
 }

@@ -94,30 +94,39 @@ fn intersecting_pairs(
 mod tests {
     use super::*;
 
+    /// Appends the n×n grid of triangles spanning `origin + s·u + t·v` (s, t in [0, 1]).
+    fn square(
+        origin: [f32; 3],
+        u: [f32; 3],
+        v: [f32; 3],
+        n: usize,
+        positions: &mut Vec<[f32; 3]>,
+        faces: &mut Vec<[u32; 3]>,
+    ) {
+        let base = positions.len() as u32;
+        for j in 0..=n {
+            for i in 0..=n {
+                let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+                positions.push([0, 1, 2].map(|k| origin[k] + s * u[k] + t * v[k]));
+            }
+        }
+        let at = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
+        for j in 0..n {
+            for i in 0..n {
+                faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+
     /// Two separate squares, one poked through the other, and the count of crossing pairs found
     /// by testing every pair directly.
     #[test]
     fn the_grid_finds_what_every_pair_finds() {
         let mut positions: Vec<[f32; 3]> = Vec::new();
         let mut faces: Vec<[u32; 3]> = Vec::new();
-        let mut square = |origin: [f32; 3], u: [f32; 3], v: [f32; 3], n: usize| {
-            let base = positions.len() as u32;
-            for j in 0..=n {
-                for i in 0..=n {
-                    let (a, b) = (i as f32 / n as f32, j as f32 / n as f32);
-                    positions.push([0, 1, 2].map(|k| origin[k] + a * u[k] + b * v[k]));
-                }
-            }
-            let at = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
-            for j in 0..n {
-                for i in 0..n {
-                    faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                    faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-                }
-            }
-        };
-        square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 6);
-        square([0.33, 0.21, -0.4], [0.1, 0.3, 0.8], [0.35, -0.05, 0.1], 4);
+        square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 6, &mut positions, &mut faces);
+        square([0.33, 0.21, -0.4], [0.1, 0.3, 0.8], [0.35, -0.05, 0.1], 4, &mut positions, &mut faces);
         let brute = (0..faces.len())
             .flat_map(|i| (i + 1..faces.len()).map(move |j| (i, j)))
             .filter(|&(i, j)| !faces[i].iter().any(|v| faces[j].contains(v)))
@@ -134,30 +143,10 @@ mod tests {
     /// the pairs of a triangle of `a` and one of `b` count, as testing every such pair finds.
     #[test]
     fn crossings_count_only_pairs_across_the_meshes() {
-        let square = |origin: [f32; 3], u: [f32; 3], v: [f32; 3], n: usize, positions: &mut Vec<[f32; 3]>| {
-            let base = positions.len() as u32;
-            for j in 0..=n {
-                for i in 0..=n {
-                    let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
-                    positions.push([0, 1, 2].map(|k| origin[k] + s * u[k] + t * v[k]));
-                }
-            }
-            let at = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
-            (0..n)
-                .flat_map(|j| {
-                    (0..n).flat_map(move |i| {
-                        [
-                            [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
-                            [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
-                        ]
-                    })
-                })
-                .collect::<Vec<_>>()
-        };
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        let mut a_faces = square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 5, &mut a);
-        a_faces.extend(square([0.2, 0.3, -0.5], [0.6, 0.1, 0.0], [0.0, 0.2, 1.0], 4, &mut a));
-        let b_faces = square([0.1, 0.6, -0.3], [0.7, -0.2, 0.1], [0.1, 0.1, 0.9], 3, &mut b);
+        let (mut a, mut a_faces, mut b, mut b_faces) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 5, &mut a, &mut a_faces);
+        square([0.2, 0.3, -0.5], [0.6, 0.1, 0.0], [0.0, 0.2, 1.0], 4, &mut a, &mut a_faces);
+        square([0.1, 0.6, -0.3], [0.7, -0.2, 0.1], [0.1, 0.1, 0.9], 3, &mut b, &mut b_faces);
         let corners = |p: &[[f32; 3]], f: [u32; 3]| f.map(|k| p[k as usize].map(f64::from));
         let brute = a_faces
             .iter()
