@@ -1,0 +1,21 @@
+//! A person's own photo or video in: pretrained person models (detection, landmarks, masks) run
+//! with tract, and the body fitted to what they find (thesis §2.2.2).
+
+pub mod blazepose;
+pub mod body_fit;
+pub mod crop;
+pub mod error;
+pub mod landmark_body;
+pub mod levenberg_marquardt;
+pub mod network;
+pub mod overlay;
+pub mod person_models;
+pub mod pose_detector;
+pub mod pose_landmarker;
+pub mod pose_prior;
+pub mod rigid_alignment;
+pub mod ssd_anchors;
+
+pub use body_fit::{BodyFit, fit_body};
+pub use error::FitError;
+pub use person_models::{Person, PersonModels};

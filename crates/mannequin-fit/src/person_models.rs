@@ -1,0 +1,63 @@
+//! The shipped person models, loaded once: MediaPipe's pose detector, pose landmarker and
+//! selfie segmenter (Apache-2.0, converted to ONNX by `tools/person_models`; see
+//! `models/NOTICE.md`).
+
+use mannequin_data::Image;
+
+use crate::crop::{Border, crop, uncrop};
+use crate::error::FitError;
+use crate::network::Network;
+use crate::pose_detector::{Detection, detect, letterbox};
+use crate::pose_landmarker::{MIN_POSE_FLAG, PoseLandmarks, detection_roi, estimate};
+
+const POSE_DETECTION: &[u8] = include_bytes!("../models/pose_detection.onnx");
+const POSE_LANDMARK: &[u8] = include_bytes!("../models/pose_landmark_full.onnx");
+const SELFIE_SEGMENTATION: &[u8] = include_bytes!("../models/selfie_segmentation.onnx");
+const SELFIE_SIZE: usize = 256;
+
+/// The three networks, ready to run.
+pub struct PersonModels {
+    pub detector: Network,
+    pub landmarker: Network,
+    pub segmenter: Network,
+}
+
+/// One person found in a picture.
+#[derive(Debug, Clone)]
+pub struct Person {
+    pub detection: Detection,
+    pub landmarks: PoseLandmarks,
+}
+
+impl PersonModels {
+    pub fn load() -> Result<Self, FitError> {
+        Ok(Self {
+            detector: Network::load("pose_detection", POSE_DETECTION)?,
+            landmarker: Network::load("pose_landmark_full", POSE_LANDMARK)?,
+            segmenter: Network::load("selfie_segmentation", SELFIE_SEGMENTATION)?,
+        })
+    }
+
+    /// Everyone the detector finds whose landmark crop the landmarker confirms, largest box
+    /// first.
+    pub fn people(&self, image: &Image) -> Result<Vec<Person>, FitError> {
+        let mut out = Vec::new();
+        for detection in detect(&self.detector, image)? {
+            let landmarks = estimate(&self.landmarker, image, detection_roi(&detection))?;
+            if landmarks.flag >= MIN_POSE_FLAG {
+                out.push(Person { detection, landmarks });
+            }
+        }
+        out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
+        Ok(out)
+    }
+
+    /// The probability that each pixel shows a person (anyone), from the selfie segmenter run
+    /// on the whole picture letterboxed to 256².
+    pub fn segment(&self, image: &Image) -> Result<Vec<f32>, FitError> {
+        let lb = letterbox(image);
+        let out = self.segmenter.run(crop(image, &lb, SELFIE_SIZE, Border::Zero))?;
+        let mask = &out[self.segmenter.output_index("mask")?].values;
+        Ok(uncrop(mask, SELFIE_SIZE, &lb, image.width, image.height))
+    }
+}
