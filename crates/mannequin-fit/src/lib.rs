@@ -4,6 +4,7 @@
 pub mod blazepose;
 pub mod body_fit;
 pub mod crop;
+pub mod distance_transform;
 pub mod error;
 pub mod landmark_body;
 pub mod levenberg_marquardt;

@@ -3,8 +3,9 @@
 //! it checks — "constraints of the joint rotation matrix" — is written down here instead, from
 //! anatomy: each joint's axis-angle components stay inside a range of motion (knees and elbows
 //! are hinges that bend one way; shoulders swing far, spines and necks little), and every joint
-//! is pulled gently toward rest so that what the image does not show stays plausible. A learned
-//! prior would plug in as another residual block beside these.
+//! is pulled gently toward a relaxed stance (arms down, elbows a little bent), so that what the
+//! image does not show — an arm out of the picture — stays plausible. A learned prior would
+//! plug in as another residual block beside these.
 
 use mannequin_body::smpl_joint::*;
 
@@ -39,6 +40,22 @@ pub fn range_of_motion(joint: usize) -> [(f32, f32); 3] {
     }
 }
 
+/// Shoulders turned down by this much (radians) about z in the relaxed stance.
+const ARMS_DOWN: f64 = 1.2;
+const ELBOWS_BENT: f64 = 0.25;
+
+/// The relaxed stance the prior pulls toward, as a body pose (joints 1..24 × 3): arms hanging
+/// about 20° out from the body, elbows slightly bent. Fits start from it too.
+pub fn relaxed_pose() -> Vec<f64> {
+    let mut p = vec![0.0; 69];
+    let mut set = |joint: usize, axis: usize, v: f64| p[3 * (joint - 1) + axis] = v;
+    set(L_SHOULDER, 2, -ARMS_DOWN);
+    set(R_SHOULDER, 2, ARMS_DOWN);
+    set(L_ELBOW, 1, -ELBOWS_BENT);
+    set(R_ELBOW, 1, ELBOWS_BENT);
+    p
+}
+
 /// How strongly joint `j` is pulled toward rest, relative to the others: joints the landmarks
 /// see poorly (spine segments, toes, hands) more, the limbs' big joints less.
 pub fn rest_weight(joint: usize) -> f32 {
@@ -51,15 +68,16 @@ pub fn rest_weight(joint: usize) -> f32 {
 }
 
 /// Residuals of the prior for a body pose (joints 1..24 × 3): how far each component leaves its
-/// range, times `limit`, then each component times `rest` · [`rest_weight`].
-pub fn residuals(body_pose: &[f64], limit: f64, rest: f64, out: &mut Vec<f64>) {
-    for (k, r) in body_pose.chunks_exact(3).enumerate() {
+/// range, times `limit`, then each component's distance from `relaxed` (see [`relaxed_pose`])
+/// times `rest` · [`rest_weight`].
+pub fn residuals(body_pose: &[f64], relaxed: &[f64], limit: f64, rest: f64, out: &mut Vec<f64>) {
+    for (k, (r, q)) in body_pose.chunks_exact(3).zip(relaxed.chunks_exact(3)).enumerate() {
         let joint = k + 1;
         let rom = range_of_motion(joint);
-        for (c, &v) in r.iter().enumerate() {
-            let (lo, hi) = (rom[c].0 as f64, rom[c].1 as f64);
+        for c in 0..3 {
+            let (lo, hi, v) = (rom[c].0 as f64, rom[c].1 as f64, r[c]);
             out.push(limit * ((lo - v).max(0.0) + (v - hi).max(0.0)));
-            out.push(rest * rest_weight(joint) as f64 * v);
+            out.push(rest * rest_weight(joint) as f64 * (v - q[c]));
         }
     }
 }
@@ -75,10 +93,17 @@ mod tests {
             let pose = mannequin_body::named_pose(name).unwrap();
             let body: Vec<f64> = pose[3..].iter().map(|&v| v as f64).collect();
             let mut r = Vec::new();
-            residuals(&body, 1.0, 0.0, &mut r);
+            residuals(&body, &relaxed_pose(), 1.0, 0.0, &mut r);
             let worst = r.iter().step_by(2).fold(0.0f64, |a, &b| a.max(b));
             assert!(worst < 1e-6, "{name} leaves a range by {worst}");
         }
+    }
+
+    #[test]
+    fn the_relaxed_stance_is_inside_the_ranges_and_costs_nothing() {
+        let mut r = Vec::new();
+        residuals(&relaxed_pose(), &relaxed_pose(), 1.0, 1.0, &mut r);
+        assert!(r.iter().all(|&v| v == 0.0));
     }
 
     #[test]
@@ -86,7 +111,7 @@ mod tests {
         let mut body = vec![0.0; 69];
         body[3 * (L_KNEE - 1)] = -0.5;
         let mut r = Vec::new();
-        residuals(&body, 1.0, 0.0, &mut r);
+        residuals(&body, &relaxed_pose(), 1.0, 0.0, &mut r);
         let knee = 2 * 3 * (L_KNEE - 1);
         assert!((r[knee] - 0.45).abs() < 1e-6, "{}", r[knee]);
     }

@@ -10,6 +10,7 @@ mod demo;
 mod dress;
 mod eval;
 mod export;
+mod fit;
 mod garment;
 mod motion;
 mod pose_choice;
@@ -45,6 +46,9 @@ enum Command {
     /// Dress a body of any shape in garments and play a motion: skinned transfer (MGN) and cloth
     /// simulation, as a glTF scene, point caches, rendered frames and metrics.
     Dress(dress::Args),
+    /// Fit the body to a person in a photo: detection, landmarks and mask by the shipped person
+    /// models, then shape, pose and camera (body.npz, .obj, .glb, overlay.png, fit.json).
+    Fit(fit::Args),
     /// Write motion files (a procedural walk as AMASS .npz).
     #[command(subcommand)]
     Motion(motion::MotionCommand),
@@ -76,6 +80,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Cloth(cmd) => cloth::run(cmd),
         Command::Garment(cmd) => garment::run(cmd),
         Command::Dress(args) => dress::run(args),
+        Command::Fit(args) => fit::run(args),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
         Command::Demo(args) => demo::run(args),

@@ -1,0 +1,201 @@
+//! `mannequin fit --image photo.jpg --out DIR`: finds the person in a photo, reads their
+//! landmarks and mask with the shipped person models, and fits the body to them (thesis §2.2.2).
+//! Writes the body in SMPL's layout with its camera, as meshes, an overlay to check it by, and
+//! the fit's numbers.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use mannequin_body::{BodyModel, forward, skeletal_animation, skinned_body};
+use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_data::{Image, Mask};
+use mannequin_fit::body_fit::assumed_focal;
+use mannequin_fit::overlay::overlay;
+use mannequin_fit::{BodyFit, Person, PersonModels, fit_body};
+use mannequin_io::{NpyArray, NpzWriter};
+use mannequin_mesh::TriMesh;
+
+use crate::body::load_body;
+
+/// The detector reads a 224² letterbox: smaller pictures hold too little to find a body in.
+const MIN_SIDE: usize = 128;
+/// Two people whose boxes are this close in area are too alike to pick between.
+const SAME_SIZE: f32 = 0.85;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The photo: PNG or JPEG.
+    #[arg(long)]
+    image: PathBuf,
+    /// Which person to fit, counting from 0 in order of size (largest first).
+    #[arg(long)]
+    person: Option<usize>,
+    /// The body model (the landmark table is made for the embedded default).
+    #[arg(long, default_value = "default")]
+    body: String,
+    /// Focal length in pixels; by default the picture's long side (a 53° view across it).
+    #[arg(long)]
+    focal: Option<f64>,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let start = Instant::now();
+    let image = Image::read(&args.image)?;
+    if image.width.min(image.height) < MIN_SIDE {
+        bail!(
+            "{}: the picture is {}×{}; fitting needs at least {MIN_SIDE} pixels on the short side",
+            args.image.display(),
+            image.width,
+            image.height
+        );
+    }
+    if let Some(f) = args.focal.filter(|f| !(f.is_finite() && *f > 0.0)) {
+        bail!("--focal: expected a positive number of pixels, found {f}");
+    }
+    let model = load_body(&args.body)?;
+    let models = PersonModels::load()?;
+    let people = models.people(&image)?;
+    let person = choose(&people, args.person, &args.image)?;
+    let focal = args.focal.unwrap_or_else(|| assumed_focal(image.width, image.height));
+    let fit = fit_body(&model, &person.landmarks, image.width, image.height, focal)
+        .with_context(|| format!("fitting the body to {}", args.image.display()))?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let mesh = posed_mesh(&model, &fit)?;
+    let raster = render(&mesh, &fit);
+    let person_mask = Mask {
+        width: image.width,
+        height: image.height,
+        values: person.landmarks.mask.iter().map(|&p| p > 0.5).collect(),
+    };
+    let iou = mask_iou(&raster.mask, &person_mask);
+    write_body_npz(&args.out.join("body.npz"), &fit)?;
+    crate::body::write_mesh(&args.out.join("body.obj"), &mesh)?;
+    write_glb(&args.out.join("body.glb"), &model, &fit)?;
+    let confident: Vec<bool> = fit.errors_px.iter().map(Option::is_some).collect();
+    overlay(&image, &raster, &person.landmarks.points, &confident, &fit.reprojected)
+        .write_png(&args.out.join("overlay.png"))?;
+    let report = report(&fit, person, iou, focal, start.elapsed().as_secs_f64());
+    mannequin_io::write_atomic(&args.out.join("fit.json"), serde_json::to_string_pretty(&report)?.as_bytes())
+        .with_context(|| format!("writing {}", args.out.join("fit.json").display()))?;
+    tracing::info!(
+        "fitted {}: median landmark error {:.1} px, mask IoU {:.3}, {:.1} s; wrote {}",
+        args.image.display(),
+        report["landmark_error_px"]["median"].as_f64().unwrap_or(f64::NAN),
+        iou,
+        start.elapsed().as_secs_f64(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The person `--person` names, else the only or clearly largest one.
+fn choose<'a>(people: &'a [Person], wanted: Option<usize>, path: &Path) -> Result<&'a Person> {
+    if people.is_empty() {
+        bail!("{}: no person found", path.display());
+    }
+    if let Some(n) = wanted {
+        return people.get(n).with_context(|| {
+            format!(
+                "--person {n}: {} found {} people (0 to {})",
+                path.display(),
+                people.len(),
+                people.len() - 1
+            )
+        });
+    }
+    if people.len() > 1 && people[1].detection.area() >= SAME_SIZE * people[0].detection.area() {
+        let boxes: Vec<String> = people
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let b = p.detection.bbox;
+                format!("{i}: x {:.0}–{:.0}, y {:.0}–{:.0}", b[0], b[2], b[1], b[3])
+            })
+            .collect();
+        bail!(
+            "{}: {} people of about the same size; choose one with --person N ({})",
+            path.display(),
+            people.len(),
+            boxes.join("; ")
+        );
+    }
+    Ok(&people[0])
+}
+
+fn posed_mesh(model: &BodyModel, fit: &BodyFit) -> Result<TriMesh> {
+    let posed = forward(model, &fit.betas, &fit.pose, &fit.transl)?;
+    let mut mesh = model.template_mesh();
+    mesh.positions = posed.frame_vertices(0).chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+    Ok(mesh)
+}
+
+fn render(mesh: &TriMesh, fit: &BodyFit) -> mannequin_data::mesh_raster::Raster {
+    let normals = mannequin_mesh::normals::vertex_normals(&mesh.positions, &mesh.faces);
+    let raster_mesh = RasterMesh {
+        positions: &mesh.positions,
+        faces: &mesh.faces,
+        normals: &normals,
+        shading: Shading::Flat([1.0; 3]),
+    };
+    rasterize(&raster_mesh, &fit.camera, [0.0; 3])
+}
+
+fn mask_iou(a: &Mask, b: &Mask) -> f64 {
+    let (mut inter, mut union) = (0usize, 0usize);
+    for (x, y) in a.values.iter().zip(&b.values) {
+        inter += (*x && *y) as usize;
+        union += (*x || *y) as usize;
+    }
+    if union == 0 { 0.0 } else { inter as f64 / union as f64 }
+}
+
+/// SMPL's layout as PeopleSnapshot's pose files have it (one frame), plus the camera as its
+/// `cameras.npz` has it.
+fn write_body_npz(path: &Path, fit: &BodyFit) -> Result<()> {
+    let c = &fit.camera;
+    let mut w = NpzWriter::new();
+    w.add("betas", NpyArray::f32(vec![1, fit.betas.len()], fit.betas.clone()))
+        .add("global_orient", NpyArray::f32(vec![1, 3], fit.pose[..3].to_vec()))
+        .add("body_pose", NpyArray::f32(vec![1, fit.pose.len() - 3], fit.pose[3..].to_vec()))
+        .add("transl", NpyArray::f32(vec![1, 3], fit.transl.to_vec()))
+        .add("intrinsic", NpyArray::f64(vec![3, 3], c.intrinsic.iter().flatten().copied().collect()))
+        .add("extrinsic", NpyArray::f64(vec![4, 4], c.extrinsic.iter().flatten().copied().collect()))
+        .add("height", NpyArray::i64(vec![], vec![c.height as i64]))
+        .add("width", NpyArray::i64(vec![], vec![c.width as i64]));
+    w.write(path).with_context(|| format!("writing {}", path.display()))
+}
+
+/// The shaped body, skinned, holding the fitted pose as a one-frame animation.
+fn write_glb(path: &Path, model: &BodyModel, fit: &BodyFit) -> Result<()> {
+    let skinned = skinned_body(model, &fit.betas)?;
+    let animation = skeletal_animation(model, &fit.pose, &fit.transl, 30.0)?;
+    mannequin_mesh::gltf::write_glb(path, &skinned, Some(&animation))
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+fn report(fit: &BodyFit, person: &Person, iou: f64, focal: f64, seconds: f64) -> serde_json::Value {
+    let mut errors: Vec<f32> = fit.errors_px.iter().flatten().copied().collect();
+    errors.sort_by(f32::total_cmp);
+    let median = errors.get(errors.len() / 2).copied().unwrap_or(f32::NAN);
+    let mean = errors.iter().sum::<f32>() / errors.len().max(1) as f32;
+    let per_landmark: serde_json::Map<String, serde_json::Value> = mannequin_fit::blazepose::LANDMARKS
+        .iter()
+        .zip(&fit.errors_px)
+        .map(|((name, _), e)| (name.to_string(), e.map_or(serde_json::Value::Null, |e| serde_json::json!(e))))
+        .collect();
+    serde_json::json!({
+        "landmark_error_px": { "mean": mean, "median": median, "max": errors.last(), "per_landmark": per_landmark },
+        "mask_iou": iou,
+        "seconds": seconds,
+        "focal_px": focal,
+        "detection": { "score": person.detection.score, "box": person.detection.bbox },
+        "pose_flag": person.landmarks.flag,
+        "stages": fit.stages.iter().map(|s| serde_json::json!({
+            "initial_cost": s.initial_cost, "final_cost": s.final_cost, "iterations": s.iterations
+        })).collect::<Vec<_>>(),
+    })
+}
