@@ -56,6 +56,9 @@ pub const LANDMARKS: [(&str, Anchor); 33] = [
     ("right_foot_index", Anchor::Vertex(4933)),
 ];
 
+/// The vertex count of the body the table's vertices index.
+pub const DEFAULT_BODY_VERTICES: usize = 13380;
+
 pub const LEFT_HIP: usize = 23;
 pub const RIGHT_HIP: usize = 24;
 pub const LEFT_SHOULDER: usize = 11;

@@ -25,7 +25,10 @@ use mannequin_body::rodrigues::{axis_angle_quat, quat_axis_angle};
 use mannequin_body::smpl_joint::{L_HIP, L_SHOULDER, PELVIS, R_HIP, R_SHOULDER};
 use mannequin_data::Camera;
 
-use crate::blazepose::{Anchor, LANDMARKS, LEFT_HIP, LEFT_SHOULDER, RIGHT_HIP, RIGHT_SHOULDER};
+use crate::blazepose::{
+    Anchor as LandmarkAnchor, DEFAULT_BODY_VERTICES, LANDMARKS, LEFT_HIP, LEFT_SHOULDER, RIGHT_HIP,
+    RIGHT_SHOULDER,
+};
 use crate::distance_transform::distance_to;
 use crate::error::FitError;
 use crate::landmark_body::{LandmarkBody, PosedLandmarks};
@@ -137,138 +140,191 @@ pub fn assumed_focal(width: usize, height: usize) -> f64 {
 
 fn anchor_point(posed: &PosedLandmarks, vertex_slot: &[Option<usize>], i: usize) -> Option<Vec3> {
     match LANDMARKS[i].1 {
-        Anchor::Joint(j) => Some(posed.joints[j]),
-        Anchor::Vertex(_) => vertex_slot[i].map(|s| posed.vertices[s]),
-        Anchor::Unmapped => None,
+        LandmarkAnchor::Joint(j) => Some(posed.joints[j]),
+        LandmarkAnchor::Vertex(_) => vertex_slot[i].map(|s| posed.vertices[s]),
+        LandmarkAnchor::Unmapped => None,
     }
 }
 
-/// Fits the body to one person's landmarks and mask (`person.mask`, probabilities) in a
-/// `width` × `height` picture.
-pub fn fit_body(
-    model: &BodyModel,
-    person: &PoseLandmarks,
-    width: usize,
-    height: usize,
-    focal: f64,
-) -> Result<BodyFit, FitError> {
-    if person.mask.len() != width * height || width < 2 || height < 2 {
-        return Err(FitError::input(
-            "mask",
-            format!("{} values for a {width}×{height} picture", person.mask.len()),
-        ));
-    }
-    if person.points.len() != NUM_LANDMARKS {
-        return Err(FitError::input(
-            "landmarks",
-            format!("{} given, expected {NUM_LANDMARKS}", person.points.len()),
-        ));
-    }
-    let mut vertices = Vec::new();
-    let mut vertex_slot = vec![None; NUM_LANDMARKS];
-    for (i, (_, anchor)) in LANDMARKS.iter().enumerate() {
-        if let Anchor::Vertex(v) = anchor {
-            if *v >= model.num_vertices() {
-                return Err(FitError::input(
-                    "body",
-                    format!(
-                        "the landmark table is made for the default body's {} vertices; this body has {}",
-                        13380,
-                        model.num_vertices()
-                    ),
-                ));
-            }
-            vertex_slot[i] = Some(vertices.len());
-            vertices.push(*v);
-        }
-    }
-    let landmark_vertices = vertices.len();
-    let step = (model.num_vertices() / SILHOUETTE_SAMPLES).max(1);
-    vertices.extend((0..model.num_vertices()).step_by(step));
-    let body = LandmarkBody::new(model, &vertices);
-    let layout = Layout { betas: body.num_betas() };
-    let camera = picture_camera(width, height, focal);
-    let observed = Observed {
-        points: person.points.iter().map(|p| [p[0] as f64, p[1] as f64]).collect(),
-        world: person.world.iter().map(|w| DVec3::new(w[0] as f64, w[1] as f64, w[2] as f64)).collect(),
-        confidence: person
-            .visibility
-            .iter()
-            .zip(&person.presence)
-            .map(|(v, p)| {
-                let c = v * p;
-                if c >= MIN_CONFIDENCE { c as f64 } else { 0.0 }
-            })
-            .collect(),
-        unit_px: PIXEL_UNIT * person.roi.width as f64,
-        outside: {
-            let inside: Vec<bool> = person.mask.iter().map(|&p| p > 0.5).collect();
-            inside.iter().any(|&b| b).then(|| distance_to(&inside, width, height))
-        },
-        width,
-        height,
-    };
-    let relaxed = pose_prior::relaxed_pose();
-    let mut params = initial_parameters(&body, &layout, &observed, &camera, &relaxed)?;
-    let problem = Problem {
-        body: &body,
-        layout: &layout,
-        observed: &observed,
-        camera: &camera,
-        vertex_slot: &vertex_slot,
-        landmark_vertices,
-        relaxed: &relaxed,
-    };
-    let residuals = |rest: f64| {
-        let problem = &problem;
-        move |p: &[f64]| -> Vec<f64> { problem.residuals(p, rest) }
-    };
-    let global: Vec<usize> = (0..3).chain(layout.transl()..layout.len()).collect();
-    let all: Vec<usize> = (0..layout.len()).collect();
-    let stages = vec![
-        minimise(&residuals(REST_WEIGHT), &mut params, &global, 30, 1e-4),
-        minimise(&residuals(4.0 * REST_WEIGHT), &mut params, &all, 40, 1e-4),
-        minimise(&residuals(REST_WEIGHT), &mut params, &all, 60, 1e-4),
-    ];
-    let (pose, betas, transl) = layout.unpack(&params);
-    let posed = body.pose(&betas, &pose, transl);
-    let reprojected: Vec<Option<[f32; 2]>> = (0..NUM_LANDMARKS)
-        .map(|i| {
-            anchor_point(&posed, &vertex_slot, i).map(|p| {
-                let [u, v] = camera.project(camera.world_to_camera(p.as_dvec3()));
-                [u as f32, v as f32]
-            })
-        })
-        .collect();
-    let errors_px = reprojected
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            r.filter(|_| observed.confidence[i] > 0.0).map(|[u, v]| {
-                ((u as f64 - observed.points[i][0]).hypot(v as f64 - observed.points[i][1])) as f32
-            })
-        })
-        .collect();
-    Ok(BodyFit { betas, pose, transl: transl.to_array(), camera, reprojected, errors_px, stages })
-}
-
-/// Everything the residuals read besides the parameters.
-struct Problem<'a> {
-    body: &'a LandmarkBody,
-    layout: &'a Layout,
-    observed: &'a Observed,
-    camera: &'a Camera,
+/// The fit's fixed parts for one body and one camera: reusable over the frames of a video.
+pub struct Fitter {
+    body: LandmarkBody,
+    layout: Layout,
+    camera: Camera,
     /// Where each landmark's vertex sits among the tracked ones.
-    vertex_slot: &'a [Option<usize>],
+    vertex_slot: Vec<Option<usize>>,
     /// Tracked vertices past this many are silhouette samples.
     landmark_vertices: usize,
-    relaxed: &'a [f64],
+    relaxed: Vec<f64>,
+}
+
+/// A pull toward earlier parameters (the previous video frame), with its weight per radian and
+/// per metre.
+pub struct Anchor<'a> {
+    pub pose: &'a [f32],
+    pub transl: [f32; 3],
+    pub weight: f64,
+}
+
+impl Fitter {
+    /// For pictures of `width` × `height` pixels through a camera of focal `focal` pixels.
+    pub fn new(model: &BodyModel, width: usize, height: usize, focal: f64) -> Result<Self, FitError> {
+        if width < 2 || height < 2 || !(focal.is_finite() && focal > 0.0) {
+            return Err(FitError::input(
+                "camera",
+                format!("a {width}×{height} picture with focal {focal} px"),
+            ));
+        }
+        let mut vertices = Vec::new();
+        let mut vertex_slot = vec![None; NUM_LANDMARKS];
+        for (i, (_, anchor)) in LANDMARKS.iter().enumerate() {
+            if let LandmarkAnchor::Vertex(v) = anchor {
+                if *v >= model.num_vertices() {
+                    return Err(FitError::input(
+                        "body",
+                        format!(
+                            "the landmark table is made for the default body's {DEFAULT_BODY_VERTICES} vertices; this body has {}",
+                            model.num_vertices()
+                        ),
+                    ));
+                }
+                vertex_slot[i] = Some(vertices.len());
+                vertices.push(*v);
+            }
+        }
+        let landmark_vertices = vertices.len();
+        let step = (model.num_vertices() / SILHOUETTE_SAMPLES).max(1);
+        vertices.extend((0..model.num_vertices()).step_by(step));
+        let body = LandmarkBody::new(model, &vertices);
+        let layout = Layout { betas: body.num_betas() };
+        Ok(Self {
+            body,
+            layout,
+            camera: picture_camera(width, height, focal),
+            vertex_slot,
+            landmark_vertices,
+            relaxed: pose_prior::relaxed_pose(),
+        })
+    }
+
+    /// What the fit compares the body with, from one person's landmarks and mask.
+    fn observe(&self, person: &PoseLandmarks) -> Result<Observed, FitError> {
+        let (width, height) = (self.camera.width, self.camera.height);
+        if person.mask.len() != width * height {
+            return Err(FitError::input(
+                "mask",
+                format!("{} values for a {width}×{height} picture", person.mask.len()),
+            ));
+        }
+        if person.points.len() != NUM_LANDMARKS {
+            return Err(FitError::input(
+                "landmarks",
+                format!("{} given, expected {NUM_LANDMARKS}", person.points.len()),
+            ));
+        }
+        let inside: Vec<bool> = person.mask.iter().map(|&p| p > 0.5).collect();
+        Ok(Observed {
+            points: person.points.iter().map(|p| [p[0] as f64, p[1] as f64]).collect(),
+            world: person.world.iter().map(|w| DVec3::new(w[0] as f64, w[1] as f64, w[2] as f64)).collect(),
+            confidence: person
+                .visibility
+                .iter()
+                .zip(&person.presence)
+                .map(|(v, p)| {
+                    let c = v * p;
+                    if c >= MIN_CONFIDENCE { c as f64 } else { 0.0 }
+                })
+                .collect(),
+            unit_px: PIXEL_UNIT * person.roi.width as f64,
+            outside: inside.iter().any(|&b| b).then(|| distance_to(&inside, width, height)),
+            width,
+            height,
+        })
+    }
+
+    /// Fits shape, pose and placement from scratch, in three stages.
+    pub fn fit(&self, person: &PoseLandmarks) -> Result<BodyFit, FitError> {
+        let observed = self.observe(person)?;
+        let mut params = self.initial_parameters(&observed)?;
+        let problem = Problem { fitter: self, observed: &observed, anchor: None };
+        let layout = &self.layout;
+        let global: Vec<usize> = (0..3).chain(layout.transl()..layout.len()).collect();
+        let all: Vec<usize> = (0..layout.len()).collect();
+        let stages = vec![
+            minimise(&|p| problem.residuals(p, REST_WEIGHT), &mut params, &global, 30, 1e-4),
+            minimise(&|p| problem.residuals(p, 4.0 * REST_WEIGHT), &mut params, &all, 40, 1e-4),
+            minimise(&|p| problem.residuals(p, REST_WEIGHT), &mut params, &all, 60, 1e-4),
+        ];
+        Ok(self.result(&params, &observed, stages))
+    }
+
+    /// Fits pose and placement with the shape held at `betas`, starting from and pulled toward
+    /// `anchor` (a video's previous frame).
+    pub fn follow(
+        &self,
+        person: &PoseLandmarks,
+        betas: &[f32],
+        anchor: &Anchor,
+    ) -> Result<BodyFit, FitError> {
+        let observed = self.observe(person)?;
+        let layout = &self.layout;
+        let mut params = vec![0.0; layout.len()];
+        params[..Layout::POSE].iter_mut().zip(anchor.pose).for_each(|(p, &v)| *p = v as f64);
+        params[Layout::POSE..layout.transl()].iter_mut().zip(betas).for_each(|(p, &b)| *p = b as f64);
+        params[layout.transl()..].iter_mut().zip(anchor.transl).for_each(|(p, t)| *p = t as f64);
+        let pulled: Vec<f64> = params.clone();
+        let problem = Problem { fitter: self, observed: &observed, anchor: Some((&pulled, anchor.weight)) };
+        let free: Vec<usize> = (0..Layout::POSE).chain(layout.transl()..layout.len()).collect();
+        let stages = vec![minimise(&|p| problem.residuals(p, REST_WEIGHT), &mut params, &free, 40, 1e-4)];
+        Ok(self.result(&params, &observed, stages))
+    }
+
+    fn result(&self, params: &[f64], observed: &Observed, stages: Vec<Summary>) -> BodyFit {
+        let (pose, betas, transl) = self.layout.unpack(params);
+        let posed = self.body.pose(&betas, &pose, transl);
+        let camera = &self.camera;
+        let reprojected: Vec<Option<[f32; 2]>> = (0..NUM_LANDMARKS)
+            .map(|i| {
+                anchor_point(&posed, &self.vertex_slot, i).map(|p| {
+                    let [u, v] = camera.project(camera.world_to_camera(p.as_dvec3()));
+                    [u as f32, v as f32]
+                })
+            })
+            .collect();
+        let errors_px = reprojected
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                r.filter(|_| observed.confidence[i] > 0.0).map(|[u, v]| {
+                    ((u as f64 - observed.points[i][0]).hypot(v as f64 - observed.points[i][1])) as f32
+                })
+            })
+            .collect();
+        BodyFit {
+            betas,
+            pose,
+            transl: transl.to_array(),
+            camera: camera.clone(),
+            reprojected,
+            errors_px,
+            stages,
+        }
+    }
+}
+
+/// One frame's residuals: the fitter, what it sees, and an optional pull toward earlier
+/// parameters (with its weight).
+struct Problem<'a> {
+    fitter: &'a Fitter,
+    observed: &'a Observed,
+    anchor: Option<(&'a [f64], f64)>,
 }
 
 impl Problem<'_> {
     /// The residuals at parameters `p`, with the prior's pull to rest weighted `rest`.
     fn residuals(&self, p: &[f64], rest: f64) -> Vec<f64> {
-        let Self { body, layout, observed, camera, vertex_slot, landmark_vertices, relaxed } = *self;
+        let Fitter { body, layout, camera, vertex_slot, landmark_vertices, relaxed } = self.fitter;
+        let observed = self.observed;
         let (pose, betas, transl) = layout.unpack(p);
         let posed = body.pose(&betas, &pose, transl);
         let mut r = Vec::with_capacity(6 * NUM_LANDMARKS + 2 * 69 + layout.betas);
@@ -299,7 +355,7 @@ impl Problem<'_> {
             let w = WORLD_WEIGHT * c.sqrt() / WORLD_SIGMA;
             r.extend_from_slice(&[w * rel.x, w * rel.y, w * rel.z]);
         }
-        let samples = &posed.vertices[landmark_vertices..];
+        let samples = &posed.vertices[*landmark_vertices..];
         let w = SILHOUETTE_WEIGHT / (samples.len() as f64).sqrt() / observed.unit_px;
         for x in samples {
             let [u, v] = camera.project(camera.world_to_camera(x.as_dvec3()));
@@ -307,42 +363,59 @@ impl Problem<'_> {
         }
         pose_prior::residuals(&p[3..Layout::POSE], relaxed, LIMIT_WEIGHT, rest, &mut r);
         r.extend(p[Layout::POSE..layout.transl()].iter().map(|b| SHAPE_WEIGHT * b));
+        if let Some((q, w)) = self.anchor {
+            let moving = (0..Layout::POSE).chain(layout.transl()..layout.len());
+            r.extend(moving.map(|i| w * (p[i] - q[i])));
+        }
         r
     }
 }
 
-/// The starting parameters: the relaxed stance, turned and placed onto the landmarks.
-fn initial_parameters(
-    body: &LandmarkBody,
-    layout: &Layout,
-    observed: &Observed,
-    camera: &Camera,
-    relaxed: &[f64],
-) -> Result<Vec<f64>, FitError> {
-    let mut p = vec![0.0; layout.len()];
-    p[3..Layout::POSE].copy_from_slice(relaxed);
-    let betas = vec![0.0f32; layout.betas];
-    let rest = body.rest_joints(&betas);
-    let torso =
-        [(LEFT_HIP, L_HIP), (RIGHT_HIP, R_HIP), (LEFT_SHOULDER, L_SHOULDER), (RIGHT_SHOULDER, R_SHOULDER)];
-    let a: Vec<DVec3> = torso.iter().map(|&(_, j)| rest[j].as_dvec3()).collect();
-    let b: Vec<DVec3> = torso.iter().map(|&(i, _)| flip(observed.world[i])).collect();
-    let w: Vec<f64> = torso.iter().map(|&(i, _)| observed.confidence[i].max(1e-3)).collect();
-    let rotation = best_rotation(&a, &b, &w).ok_or_else(|| {
-        FitError::input("landmarks", "the hips and shoulders do not fix the body's orientation")
-    })?;
-    let q = glam::Quat::from_mat3(&DMat3::as_mat3(&rotation)).normalize();
-    let global = quat_axis_angle(q);
-    p[..3].copy_from_slice(&global.map(|v| v as f64));
-    let hips_cam = hip_position(observed, camera)
-        .ok_or_else(|| FitError::input("landmarks", "too few confident landmarks to place the body"))?;
-    let hips_world = flip(hips_cam);
-    let hip_rest = (rest[L_HIP] + rest[R_HIP]).as_dvec3() / 2.0;
-    let pelvis = rest[PELVIS].as_dvec3();
-    let turned = DMat3::from_quat(axis_angle_quat(global).as_dquat());
-    let t = hips_world - pelvis - turned * (hip_rest - pelvis);
-    p[layout.transl()..].copy_from_slice(&t.to_array());
-    Ok(p)
+impl Fitter {
+    /// The starting parameters: the relaxed stance, turned and placed onto the landmarks.
+    fn initial_parameters(&self, observed: &Observed) -> Result<Vec<f64>, FitError> {
+        let Self { body, layout, camera, relaxed, .. } = self;
+        let mut p = vec![0.0; layout.len()];
+        p[3..Layout::POSE].copy_from_slice(relaxed);
+        let betas = vec![0.0f32; layout.betas];
+        let rest = body.rest_joints(&betas);
+        let torso = [
+            (LEFT_HIP, L_HIP),
+            (RIGHT_HIP, R_HIP),
+            (LEFT_SHOULDER, L_SHOULDER),
+            (RIGHT_SHOULDER, R_SHOULDER),
+        ];
+        let a: Vec<DVec3> = torso.iter().map(|&(_, j)| rest[j].as_dvec3()).collect();
+        let b: Vec<DVec3> = torso.iter().map(|&(i, _)| flip(observed.world[i])).collect();
+        let w: Vec<f64> = torso.iter().map(|&(i, _)| observed.confidence[i].max(1e-3)).collect();
+        let rotation = best_rotation(&a, &b, &w).ok_or_else(|| {
+            FitError::input("landmarks", "the hips and shoulders do not fix the body's orientation")
+        })?;
+        let q = glam::Quat::from_mat3(&DMat3::as_mat3(&rotation)).normalize();
+        let global = quat_axis_angle(q);
+        p[..3].copy_from_slice(&global.map(|v| v as f64));
+        let hips_cam = hip_position(observed, camera)
+            .ok_or_else(|| FitError::input("landmarks", "too few confident landmarks to place the body"))?;
+        let hips_world = flip(hips_cam);
+        let hip_rest = (rest[L_HIP] + rest[R_HIP]).as_dvec3() / 2.0;
+        let pelvis = rest[PELVIS].as_dvec3();
+        let turned = DMat3::from_quat(axis_angle_quat(global).as_dquat());
+        let t = hips_world - pelvis - turned * (hip_rest - pelvis);
+        p[layout.transl()..].copy_from_slice(&t.to_array());
+        Ok(p)
+    }
+}
+
+/// Fits the body to one person's landmarks and mask (`person.mask`, probabilities) in a
+/// `width` × `height` picture.
+pub fn fit_body(
+    model: &BodyModel,
+    person: &PoseLandmarks,
+    width: usize,
+    height: usize,
+    focal: f64,
+) -> Result<BodyFit, FitError> {
+    Fitter::new(model, width, height, focal)?.fit(person)
 }
 
 /// The camera-space hip centre that best explains the 2D landmarks, given the world landmarks
@@ -400,9 +473,9 @@ mod tests {
         let anchors: Vec<Option<Vec3>> = LANDMARKS
             .iter()
             .map(|(_, a)| match *a {
-                Anchor::Joint(j) => Some(joint(j)),
-                Anchor::Vertex(v) => Some(vertex(v)),
-                Anchor::Unmapped => None,
+                LandmarkAnchor::Joint(j) => Some(joint(j)),
+                LandmarkAnchor::Vertex(v) => Some(vertex(v)),
+                LandmarkAnchor::Unmapped => None,
             })
             .collect();
         let hips = flip((joint(L_HIP) + joint(R_HIP)).as_dvec3() / 2.0);
