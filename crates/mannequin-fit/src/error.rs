@@ -6,6 +6,9 @@ pub enum FitError {
     Model { model: &'static str, reason: String },
     #[error("{what}: {reason}")]
     Input { what: String, reason: String },
+    /// What a picture holds (or lacks), said of the picture as a whole.
+    #[error("{0}")]
+    Picture(String),
     #[error(transparent)]
     Body(#[from] mannequin_body::BodyError),
     #[error(transparent)]

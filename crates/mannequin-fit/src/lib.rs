@@ -3,6 +3,7 @@
 
 pub mod blazepose;
 pub mod body_fit;
+pub mod capture;
 pub mod crop;
 pub mod distance_transform;
 pub mod error;
@@ -19,4 +20,4 @@ pub mod ssd_anchors;
 
 pub use body_fit::{BodyFit, fit_body};
 pub use error::FitError;
-pub use person_models::{Person, PersonModels};
+pub use person_models::{Person, PersonModels, pick_person};

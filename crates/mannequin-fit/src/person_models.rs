@@ -14,6 +14,8 @@ const POSE_DETECTION: &[u8] = include_bytes!("../models/pose_detection.onnx");
 const POSE_LANDMARK: &[u8] = include_bytes!("../models/pose_landmark_full.onnx");
 const SELFIE_SEGMENTATION: &[u8] = include_bytes!("../models/selfie_segmentation.onnx");
 const SELFIE_SIZE: usize = 256;
+/// Two people whose boxes are this close in area are too alike to pick between.
+const SAME_SIZE: f32 = 0.85;
 
 /// The three networks, ready to run.
 pub struct PersonModels {
@@ -52,6 +54,13 @@ impl PersonModels {
         Ok(out)
     }
 
+    /// The same person in the next video frame, read in the crop their landmarks in the previous
+    /// frame point to (MediaPipe's tracking); None once the landmarker loses them.
+    pub fn follow(&self, image: &Image, previous: &PoseLandmarks) -> Result<Option<PoseLandmarks>, FitError> {
+        let landmarks = estimate(&self.landmarker, image, previous.next_roi)?;
+        Ok((landmarks.flag >= MIN_POSE_FLAG).then_some(landmarks))
+    }
+
     /// The probability that each pixel shows a person (anyone), from the selfie segmenter run
     /// on the whole picture letterboxed to 256².
     pub fn segment(&self, image: &Image) -> Result<Vec<f32>, FitError> {
@@ -60,4 +69,36 @@ impl PersonModels {
         let mask = &out[self.segmenter.output_index("mask")?].values;
         Ok(uncrop(mask, SELFIE_SIZE, &lb, image.width, image.height))
     }
+}
+
+/// The person `wanted` names (counting from 0, largest first), else the only or clearly largest
+/// one of `people` (sorted as [`PersonModels::people`] sorts them).
+pub fn pick_person(people: &[Person], wanted: Option<usize>) -> Result<&Person, FitError> {
+    if people.is_empty() {
+        return Err(FitError::Picture("no person found".into()));
+    }
+    if let Some(n) = wanted {
+        return people.get(n).ok_or_else(|| {
+            FitError::input(
+                format!("--person {n}"),
+                format!("found {} people (0 to {})", people.len(), people.len() - 1),
+            )
+        });
+    }
+    if people.len() > 1 && people[1].detection.area() >= SAME_SIZE * people[0].detection.area() {
+        let boxes: Vec<String> = people
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let b = p.detection.bbox;
+                format!("{i}: x {:.0}–{:.0}, y {:.0}–{:.0}", b[0], b[2], b[1], b[3])
+            })
+            .collect();
+        return Err(FitError::Picture(format!(
+            "{} people of about the same size; choose one with --person N ({})",
+            people.len(),
+            boxes.join("; ")
+        )));
+    }
+    Ok(&people[0])
 }

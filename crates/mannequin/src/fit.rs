@@ -12,7 +12,7 @@ use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
 use mannequin_data::{Image, Mask};
 use mannequin_fit::body_fit::assumed_focal;
 use mannequin_fit::overlay::overlay;
-use mannequin_fit::{BodyFit, Person, PersonModels, fit_body};
+use mannequin_fit::{BodyFit, Person, PersonModels, fit_body, pick_person};
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
 
@@ -20,8 +20,6 @@ use crate::body::load_body;
 
 /// The detector reads a 224² letterbox: smaller pictures hold too little to find a body in.
 const MIN_SIDE: usize = 128;
-/// Two people whose boxes are this close in area are too alike to pick between.
-const SAME_SIZE: f32 = 0.85;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -59,7 +57,7 @@ pub fn run(args: Args) -> Result<()> {
     let model = load_body(&args.body)?;
     let models = PersonModels::load()?;
     let people = models.people(&image)?;
-    let person = choose(&people, args.person, &args.image)?;
+    let person = pick_person(&people, args.person).with_context(|| args.image.display().to_string())?;
     let focal = args.focal.unwrap_or_else(|| assumed_focal(image.width, image.height));
     let fit = fit_body(&model, &person.landmarks, image.width, image.height, focal)
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
@@ -90,40 +88,6 @@ pub fn run(args: Args) -> Result<()> {
         args.out.display()
     );
     Ok(())
-}
-
-/// The person `--person` names, else the only or clearly largest one.
-fn choose<'a>(people: &'a [Person], wanted: Option<usize>, path: &Path) -> Result<&'a Person> {
-    if people.is_empty() {
-        bail!("{}: no person found", path.display());
-    }
-    if let Some(n) = wanted {
-        return people.get(n).with_context(|| {
-            format!(
-                "--person {n}: {} found {} people (0 to {})",
-                path.display(),
-                people.len(),
-                people.len() - 1
-            )
-        });
-    }
-    if people.len() > 1 && people[1].detection.area() >= SAME_SIZE * people[0].detection.area() {
-        let boxes: Vec<String> = people
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let b = p.detection.bbox;
-                format!("{i}: x {:.0}–{:.0}, y {:.0}–{:.0}", b[0], b[2], b[1], b[3])
-            })
-            .collect();
-        bail!(
-            "{}: {} people of about the same size; choose one with --person N ({})",
-            path.display(),
-            people.len(),
-            boxes.join("; ")
-        );
-    }
-    Ok(&people[0])
 }
 
 fn posed_mesh(model: &BodyModel, fit: &BodyFit) -> Result<TriMesh> {

@@ -3,6 +3,7 @@
 
 mod animate;
 mod body;
+mod capture;
 mod checkpoint;
 mod cloth;
 mod compute;
@@ -46,6 +47,9 @@ enum Command {
     /// Dress a body of any shape in garments and play a motion: skinned transfer (MGN) and cloth
     /// simulation, as a glTF scene, point caches, rendered frames and metrics.
     Dress(dress::Args),
+    /// A person's own video (or frames) to a dataset `train` reads: landmarks and masks by the
+    /// shipped person models, one body shape, a pose per frame, one static camera.
+    Capture(capture::Args),
     /// Fit the body to a person in a photo: detection, landmarks and mask by the shipped person
     /// models, then shape, pose and camera (body.npz, .obj, .glb, overlay.png, fit.json).
     Fit(fit::Args),
@@ -80,6 +84,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Cloth(cmd) => cloth::run(cmd),
         Command::Garment(cmd) => garment::run(cmd),
         Command::Dress(args) => dress::run(args),
+        Command::Capture(args) => capture::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),

@@ -1,0 +1,92 @@
+//! `mannequin capture` as a user runs it, on a clip cut from a real photo (`camera.png`, CC0): a
+//! 448² window sliding 8 px to the right per frame, so the person slides 8 px to the left. The
+//! dataset it writes must open as a training set, and the fitted body must slide with the
+//! person, an expectation the fit never sees.
+
+use std::path::Path;
+
+mod common;
+use common::{mannequin, ok, one_line_error, s, scratch};
+use mannequin_data::{Dataset, Image};
+
+const STEP: usize = 8;
+const SIDE: usize = 448;
+
+fn camera_png() -> Image {
+    Image::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../mannequin-fit/tests/data/camera.png"))
+        .unwrap()
+}
+
+fn window(image: &Image, x0: usize) -> Image {
+    let pixels = (0..SIDE)
+        .flat_map(|y| (0..SIDE).map(move |x| (x, y)))
+        .map(|(x, y)| image.at(x0 + x, 32 + y))
+        .collect();
+    Image { width: SIDE, height: SIDE, pixels }
+}
+
+#[test]
+fn a_sliding_clip_becomes_a_dataset_whose_body_slides_with_the_person() {
+    let dir = scratch("capture_slide");
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let photo = camera_png();
+    for k in 0..5 {
+        window(&photo, STEP * k).write_png(&frames.join(format!("f{k}.png"))).unwrap();
+    }
+    let out = dir.join("dataset");
+    ok(mannequin(&["capture", "--frames", s(&frames), "--out", s(&out)]));
+    let data = Dataset::open(&out, 1).unwrap();
+    let train = data.split("train").unwrap();
+    let test = data.split("test").unwrap();
+    assert_eq!((train.frames.len(), test.frames.len()), (4, 1));
+    let model = mannequin_body::BodyModel::default_body();
+    let mut poses = train.poses.clone();
+    poses.global_orient.extend(&test.poses.global_orient);
+    poses.body_pose.extend(&test.poses.body_pose);
+    poses.transl.extend(&test.poses.transl);
+    let camera = data.camera(0);
+    // The head and neck: seen in every frame, unlike the legs (out of the picture) or the hands
+    // (on the camera, where the landmarks jump by tens of pixels as the crop moves).
+    let head_u: Vec<f64> = (0..5)
+        .map(|i| {
+            let posed =
+                mannequin_body::forward(&model, &poses.betas, &poses.pose72(i), &poses.transl[i]).unwrap();
+            let u = |j: usize| {
+                let p = glam::Vec3::from_slice(&posed.joints[3 * j..3 * j + 3]).as_dvec3();
+                camera.project(camera.world_to_camera(p))[0]
+            };
+            (u(mannequin_body::smpl_joint::HEAD) + u(mannequin_body::smpl_joint::NECK)) / 2.0
+        })
+        .collect();
+    println!("head and neck u per frame: {head_u:?}");
+    let moved = head_u[4] - head_u[0];
+    let want = -4.0 * STEP as f64;
+    assert!((moved - want).abs() < 6.0, "head and neck moved {moved:.1} px over the clip, the person {want}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("capture.json")).unwrap()).unwrap();
+    for f in report["frames"].as_array().unwrap() {
+        let e = f["median_landmark_error_px"].as_f64().unwrap();
+        assert!(e < 8.0, "median landmark error {e} px in {}", f["source"]);
+    }
+    let frame = data.frame(2).unwrap();
+    let share = frame.mask.count() as f64 / (SIDE * SIDE) as f64;
+    assert!(share > 0.2 && share < 0.8, "the mask covers {share:.2} of the frame");
+}
+
+#[test]
+fn clips_that_cannot_make_a_dataset_are_refused_in_one_line() {
+    let dir = scratch("capture_refusals");
+    let frames = dir.join("one");
+    std::fs::create_dir_all(&frames).unwrap();
+    window(&camera_png(), 0).write_png(&frames.join("f0.png")).unwrap();
+    let out = dir.join("out");
+    one_line_error(
+        &mannequin(&["capture", "--frames", s(&frames), "--out", s(&out)]),
+        &["1 frame(s)", "at least 2"],
+    );
+    one_line_error(
+        &mannequin(&["capture", "--video", s(&dir.join("missing.mp4")), "--out", s(&out)]),
+        &["missing.mp4", "no such video file"],
+    );
+}
