@@ -11,12 +11,13 @@ use anyhow::{Context, Result, bail};
 use mannequin_data::layout::IMAGE_EXTENSIONS;
 use mannequin_data::splits::SplitRange;
 use mannequin_data::{Cameras, DatasetWriter, Frame, Image, Mask, Poses, Splits};
-use mannequin_fit::body_fit::{Fitter, assumed_focal};
+use mannequin_fit::body_fit::Fitter;
 use mannequin_fit::capture::{Tracker, fit_clip, fit_clip_steps};
 use mannequin_fit::pose_landmarker::PoseLandmarks;
 use mannequin_fit::{BodyFit, PersonModels};
 
 use crate::body::load_body;
+use crate::fit::FitArgs;
 use crate::progress::{JobTimer, bar};
 
 /// The last tenth of the frames (at least one) is held out as the test split.
@@ -36,12 +37,8 @@ pub struct Args {
     /// Use at most this many frames, from the start.
     #[arg(long)]
     max_frames: Option<usize>,
-    /// The body model (the landmark table is made for the embedded default).
-    #[arg(long, default_value = "default")]
-    body: String,
-    /// Focal length in pixels; by default the frame's long side (a 53° view across it).
-    #[arg(long)]
-    focal: Option<f64>,
+    #[command(flatten)]
+    fitting: FitArgs,
     /// The dataset folder to write.
     #[arg(long)]
     out: PathBuf,
@@ -50,9 +47,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("capture");
     let start = Instant::now();
-    if let Some(f) = args.focal.filter(|f| !(f.is_finite() && *f > 0.0)) {
-        bail!("--focal: expected a positive number of pixels, found {f}");
-    }
+    args.fitting.check()?;
     let decoded = match &args.video {
         Some(video) => Some(decode_video(video, args.fps, &args.out)?),
         None => None,
@@ -65,11 +60,11 @@ pub fn run(args: Args) -> Result<()> {
     if files.len() < 2 {
         bail!("{}: {} frame(s); a capture needs at least 2", dir.display(), files.len());
     }
-    let model = load_body(&args.body)?;
+    let model = load_body(&args.fitting.body)?;
     let models = PersonModels::load()?;
     let (kept, people, skipped) = track(&models, &files)?;
     let (width, height) = (kept[0].1.width, kept[0].1.height);
-    let focal = args.focal.unwrap_or_else(|| assumed_focal(width, height));
+    let focal = args.fitting.focal(width, height);
     let fitter = Fitter::new(&model, width, height, focal)?;
     let progress = bar(fit_clip_steps(people.len()) as u64, "body fit");
     let fits = fit_clip(&fitter, &people, &mut || progress.inc(1))?;

@@ -29,15 +29,37 @@ pub struct Args {
     /// Which person to fit, counting from 0 in order of size (largest first).
     #[arg(long)]
     person: Option<usize>,
-    /// The body model (the landmark table is made for the embedded default).
-    #[arg(long, default_value = "default")]
-    body: String,
-    /// Focal length in pixels; by default the picture's long side (a 53° view across it).
-    #[arg(long)]
-    focal: Option<f64>,
+    #[command(flatten)]
+    fitting: FitArgs,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
+}
+
+/// The body and camera options `fit` and `capture` share.
+#[derive(clap::Args)]
+pub struct FitArgs {
+    /// The body model (the landmark table is made for the embedded default).
+    #[arg(long, default_value = "default")]
+    pub body: String,
+    /// Focal length in pixels; by default the picture's long side (a 53° view across it).
+    #[arg(long)]
+    focal: Option<f64>,
+}
+
+impl FitArgs {
+    /// Refuses a focal length that is no length.
+    pub fn check(&self) -> Result<()> {
+        if let Some(f) = self.focal.filter(|f| !(f.is_finite() && *f > 0.0)) {
+            bail!("--focal: expected a positive number of pixels, found {f}");
+        }
+        Ok(())
+    }
+
+    /// The focal length for pictures of `width` × `height` pixels.
+    pub fn focal(&self, width: usize, height: usize) -> f64 {
+        self.focal.unwrap_or_else(|| assumed_focal(width, height))
+    }
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -51,14 +73,12 @@ pub fn run(args: Args) -> Result<()> {
             image.height
         );
     }
-    if let Some(f) = args.focal.filter(|f| !(f.is_finite() && *f > 0.0)) {
-        bail!("--focal: expected a positive number of pixels, found {f}");
-    }
-    let model = load_body(&args.body)?;
+    args.fitting.check()?;
+    let model = load_body(&args.fitting.body)?;
     let models = PersonModels::load()?;
     let people = models.people(&image)?;
     let person = pick_person(&people, args.person).with_context(|| args.image.display().to_string())?;
-    let focal = args.focal.unwrap_or_else(|| assumed_focal(image.width, image.height));
+    let focal = args.fitting.focal(image.width, image.height);
     let fit = fit_body(&model, &person.landmarks, image.width, image.height, focal)
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
