@@ -1,13 +1,14 @@
 //! `mannequin capture --frames DIR | --video clip.mp4 --out DATASET`: a person's own video to a
 //! dataset `mannequin train` reads (the PeopleSnapshot layout): frames, the person's masks, one
 //! static camera (the person turns in front of it, as in PeopleSnapshot) and the body fitted in
-//! every frame (`mannequin_fit::capture`).
+//! every frame (`mannequin_fit::capture`), plus an overlay per frame to check the fit by.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use mannequin_body::BodyModel;
 use mannequin_data::layout::IMAGE_EXTENSIONS;
 use mannequin_data::splits::SplitRange;
 use mannequin_data::{Cameras, DatasetWriter, Frame, Image, Mask, Poses, Splits};
@@ -17,7 +18,7 @@ use mannequin_fit::pose_landmarker::PoseLandmarks;
 use mannequin_fit::{BodyFit, PersonModels};
 
 use crate::body::load_body;
-use crate::fit::FitArgs;
+use crate::fit::{FitArgs, check_picture, posed_mesh};
 use crate::progress::{JobTimer, bar};
 
 /// The last tenth of the frames (at least one) is held out as the test split.
@@ -70,10 +71,11 @@ pub fn run(args: Args) -> Result<()> {
     let fits = fit_clip(&fitter, &people, &mut || progress.inc(1))?;
     progress.finish();
     write_dataset(&args.out, &kept, &people, &fits)?;
+    let ious = write_overlays(&args.out, &model, &kept, &people, &fits)?;
     if decoded.is_some() {
         std::fs::remove_dir_all(dir).with_context(|| format!("removing {}", dir.display()))?;
     }
-    let report = report(&kept, &fits, &skipped, focal, start.elapsed().as_secs_f64());
+    let report = report(&kept, &fits, &ious, &skipped, focal, start.elapsed().as_secs_f64());
     mannequin_io::write_atomic(
         &args.out.join("capture.json"),
         serde_json::to_string_pretty(&report)?.as_bytes(),
@@ -212,9 +214,33 @@ fn write_dataset(
     Ok(())
 }
 
+/// `overlay/frame_%04d.png` for checking each frame's fit; the IoU of each body silhouette with
+/// the person's mask.
+fn write_overlays(
+    out: &Path,
+    model: &BodyModel,
+    kept: &[(PathBuf, Image)],
+    people: &[PoseLandmarks],
+    fits: &[BodyFit],
+) -> Result<Vec<f64>> {
+    let dir = out.join("overlay");
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let progress = bar(kept.len() as u64, "overlays");
+    let mut ious = Vec::with_capacity(kept.len());
+    for (i, (((_, image), person), fit)) in kept.iter().zip(people).zip(fits).enumerate() {
+        let (picture, iou) = check_picture(image, &posed_mesh(model, fit)?, person, fit);
+        picture.write_png(&dir.join(format!("frame_{i:04}.png")))?;
+        ious.push(iou);
+        progress.inc(1);
+    }
+    progress.finish();
+    Ok(ious)
+}
+
 fn report(
     kept: &[(PathBuf, Image)],
     fits: &[BodyFit],
+    ious: &[f64],
     skipped: &[PathBuf],
     focal: f64,
     seconds: f64,
@@ -225,10 +251,12 @@ fn report(
         e.get(e.len() / 2).copied()
     };
     serde_json::json!({
-        "frames": kept.iter().zip(fits).map(|((file, _), f)| serde_json::json!({
+        "frames": kept.iter().zip(fits).zip(ious).map(|(((file, _), f), iou)| serde_json::json!({
             "source": file.display().to_string(),
             "median_landmark_error_px": median(f),
+            "mask_iou": iou,
         })).collect::<Vec<_>>(),
+        "mean_mask_iou": ious.iter().sum::<f64>() / ious.len() as f64,
         "left_out": skipped.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
         "betas": fits[0].betas,
         "focal_px": focal,

@@ -12,6 +12,7 @@ use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
 use mannequin_data::{Image, Mask};
 use mannequin_fit::body_fit::assumed_focal;
 use mannequin_fit::overlay::overlay;
+use mannequin_fit::pose_landmarker::PoseLandmarks;
 use mannequin_fit::{BodyFit, Person, PersonModels, fit_body, pick_person};
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
@@ -83,19 +84,11 @@ pub fn run(args: Args) -> Result<()> {
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let mesh = posed_mesh(&model, &fit)?;
-    let raster = render(&mesh, &fit);
-    let person_mask = Mask {
-        width: image.width,
-        height: image.height,
-        values: person.landmarks.mask.iter().map(|&p| p > 0.5).collect(),
-    };
-    let iou = mask_iou(&raster.mask, &person_mask);
+    let (picture, iou) = check_picture(&image, &mesh, &person.landmarks, &fit);
     write_body_npz(&args.out.join("body.npz"), &fit)?;
     crate::body::write_mesh(&args.out.join("body.obj"), &mesh)?;
     write_glb(&args.out.join("body.glb"), &model, &fit)?;
-    let confident: Vec<bool> = fit.errors_px.iter().map(Option::is_some).collect();
-    overlay(&image, &raster, &person.landmarks.points, &confident, &fit.reprojected)
-        .write_png(&args.out.join("overlay.png"))?;
+    picture.write_png(&args.out.join("overlay.png"))?;
     let report = report(&fit, person, iou, focal, start.elapsed().as_secs_f64());
     mannequin_io::write_atomic(&args.out.join("fit.json"), serde_json::to_string_pretty(&report)?.as_bytes())
         .with_context(|| format!("writing {}", args.out.join("fit.json").display()))?;
@@ -110,7 +103,28 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-fn posed_mesh(model: &BodyModel, fit: &BodyFit) -> Result<TriMesh> {
+/// The overlay a user checks a fit by (`mannequin_fit::overlay`), and the IoU of the body's
+/// silhouette with the person's mask.
+pub fn check_picture(
+    image: &Image,
+    mesh: &TriMesh,
+    landmarks: &PoseLandmarks,
+    fit: &BodyFit,
+) -> (Image, f64) {
+    let raster = render(mesh, fit);
+    let person = Mask {
+        width: image.width,
+        height: image.height,
+        values: landmarks.mask.iter().map(|&p| p > 0.5).collect(),
+    };
+    let confident: Vec<bool> = fit.errors_px.iter().map(Option::is_some).collect();
+    (
+        overlay(image, &raster, &landmarks.points, &confident, &fit.reprojected),
+        mask_iou(&raster.mask, &person),
+    )
+}
+
+pub fn posed_mesh(model: &BodyModel, fit: &BodyFit) -> Result<TriMesh> {
     let posed = forward(model, &fit.betas, &fit.pose, &fit.transl)?;
     let mut mesh = model.template_mesh();
     mesh.positions = posed.frame_vertices(0).chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();

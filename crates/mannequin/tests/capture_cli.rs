@@ -69,6 +69,11 @@ fn a_sliding_clip_becomes_a_dataset_whose_body_slides_with_the_person() {
         let e = f["median_landmark_error_px"].as_f64().unwrap();
         assert!(e < 8.0, "median landmark error {e} px in {}", f["source"]);
     }
+    // The coat widens the mask beyond the body (one photo gives 0.60).
+    let iou = report["mean_mask_iou"].as_f64().unwrap();
+    assert!(iou > 0.5, "mean mask IoU {iou}");
+    let overlay = Image::read(&out.join("overlay/frame_0004.png")).unwrap();
+    assert_eq!((overlay.width, overlay.height), (SIDE, SIDE));
     let frame = data.frame(2).unwrap();
     let share = frame.mask.count() as f64 / (SIDE * SIDE) as f64;
     assert!(share > 0.2 && share < 0.8, "the mask covers {share:.2} of the frame");

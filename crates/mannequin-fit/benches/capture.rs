@@ -1,0 +1,146 @@
+//! Capture judged on what it was not built from (issue 21's table): synthetic subjects dressed
+//! in simulated cloth and rendered by `mannequin-synth`, whose frames go in as plain images (no
+//! poses, masks or cameras), and whose true bodies the result is compared with.
+//!
+//! Per subject: the person models and the clip fit run on the turning capture's frames, with the
+//! focal length assumed as `capture` assumes it. Then, per frame: the mask's IoU against the true
+//! mask; PA-MPJPE over the 24 joints and the per-vertex error of the fitted body against the
+//! true body under the clothes (both in camera space, after the similarity that best aligns
+//! them, as PA-MPJPE is defined); and the time. One more `fit` of a single frame, models
+//! loaded afresh, times the one-image path.
+//!
+//! `cargo bench -p mannequin-fit --bench capture -- [--seed S] [--subjects N] [--frames F]`
+
+use std::time::Instant;
+
+use glam::DVec3;
+use mannequin_body::BodyModel;
+use mannequin_data::{Camera, Dataset, Poses};
+use mannequin_fit::body_fit::{Fitter, assumed_focal};
+use mannequin_fit::capture::{Tracker, fit_clip};
+use mannequin_fit::rigid_alignment::best_rotation;
+use mannequin_fit::{PersonModels, fit_body};
+use mannequin_synth::{SynthOptions, generate};
+
+fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// Mean distance between `a` and `b` once `a` is moved onto `b` by the best similarity.
+fn aligned_error(a: &[DVec3], b: &[DVec3]) -> f64 {
+    let w = vec![1.0; a.len()];
+    let r = best_rotation(a, b, &w).expect("a body fixes a rotation");
+    let (ma, mb) = (mean(a), mean(b));
+    let num: f64 = a.iter().zip(b).map(|(p, q)| (r * (*p - ma)).dot(*q - mb)).sum();
+    let den: f64 = a.iter().map(|p| (*p - ma).length_squared()).sum();
+    let s = num / den;
+    a.iter().zip(b).map(|(p, q)| (s * (r * (*p - ma)) + mb - *q).length()).sum::<f64>() / a.len() as f64
+}
+
+fn mean(p: &[DVec3]) -> DVec3 {
+    p.iter().copied().sum::<DVec3>() / p.len() as f64
+}
+
+/// Joints and vertices of a body in a camera's space.
+fn in_camera(
+    model: &BodyModel,
+    betas: &[f32],
+    pose: &[f32],
+    transl: &[f32; 3],
+    camera: &Camera,
+) -> (Vec<DVec3>, Vec<DVec3>) {
+    let posed = mannequin_body::forward(model, betas, pose, transl).expect("pose");
+    let points = |v: &[f32]| -> Vec<DVec3> {
+        v.chunks_exact(3)
+            .map(|p| camera.world_to_camera(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)))
+            .collect()
+    };
+    (points(&posed.joints), points(&posed.vertices))
+}
+
+fn all_poses(dataset: &Dataset) -> Poses {
+    let mut all = dataset.split("train").expect("train split").poses;
+    let test = dataset.split("test").expect("test split").poses;
+    all.global_orient.extend(test.global_orient);
+    all.body_pose.extend(test.body_pose);
+    all.transl.extend(test.transl);
+    all
+}
+
+fn main() {
+    let seed: u64 = arg("--seed", 0);
+    let subjects: u64 = arg("--subjects", 1).max(1);
+    let frames: usize = arg("--frames", 120);
+    let dir = std::env::temp_dir().join(format!("mannequin-capture-bench-{}", std::process::id()));
+    let model = BodyModel::default_body();
+    let mut rows = Vec::new();
+    for subject in seed..seed + subjects {
+        let data = dir.join(format!("seed-{subject}"));
+        let summary =
+            generate(&model, &data, &SynthOptions { seed: subject, ..SynthOptions::default() }, &|| {})
+                .expect("synth");
+        let dataset = Dataset::open(&data, 1).expect("dataset");
+        let truth = all_poses(&dataset);
+        let n = frames.min(truth.len());
+        let frames: Vec<_> = (0..n).map(|i| dataset.frame(i).expect("frame")).collect();
+        let (width, height) = (frames[0].image.width, frames[0].image.height);
+
+        let start = Instant::now();
+        let models = PersonModels::load().expect("models");
+        let one = models.people(&frames[0].image).expect("people");
+        fit_body(&model, &one[0].landmarks, width, height, assumed_focal(width, height)).expect("fit");
+        let one_image = start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let mut tracker = Tracker::new(&models);
+        let people: Vec<_> =
+            frames.iter().map(|f| tracker.next(&f.image).expect("landmarks").expect("the person")).collect();
+        let fitter = Fitter::new(&model, width, height, assumed_focal(width, height)).expect("fitter");
+        let fits = fit_clip(&fitter, &people, &mut || {}).expect("clip");
+        let clip = start.elapsed().as_secs_f64();
+
+        let (mut iou, mut mpjpe, mut pve) = (0.0, 0.0, 0.0);
+        for (i, (frame, fit)) in frames.iter().zip(&fits).enumerate() {
+            let mask: Vec<bool> = people[i].mask.iter().map(|&p| p > 0.5).collect();
+            let inter = mask.iter().zip(&frame.mask.values).filter(|(a, b)| **a && **b).count();
+            let union = mask.iter().zip(&frame.mask.values).filter(|(a, b)| **a || **b).count();
+            iou += inter as f64 / union.max(1) as f64;
+            let (tj, tv) =
+                in_camera(&model, &truth.betas, &truth.pose72(i), &truth.transl[i], dataset.camera(i));
+            let (fj, fv) = in_camera(&model, &fit.betas, &fit.pose, &fit.transl, &fit.camera);
+            mpjpe += aligned_error(&fj, &tj);
+            pve += aligned_error(&fv, &tv);
+        }
+        let k = n as f64;
+        println!(
+            "seed {subject} ({:?}, {n} frames at {width}×{height}): mask IoU {:.3}, PA-MPJPE {:.1} mm, per-vertex {:.1} mm, one image {one_image:.2} s, clip {clip:.1} s",
+            summary.subject.outfit,
+            iou / k,
+            1000.0 * mpjpe / k,
+            1000.0 * pve / k
+        );
+        rows.push((iou / k, 1000.0 * mpjpe / k, 1000.0 * pve / k, one_image, clip * 120.0 / k));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let m = |f: fn(&(f64, f64, f64, f64, f64)) -> f64| rows.iter().map(f).sum::<f64>() / rows.len() as f64;
+    println!("\n| measure (mean of {} subjects) | measured | target | met |", rows.len());
+    println!("| --- | --- | --- | --- |");
+    let line = |name: &str, v: f64, target: &str, met: bool| {
+        println!("| {name} | {v:.3} | {target} | {} |", if met { "yes" } else { "no" })
+    };
+    let iou = m(|r| r.0);
+    line("mask IoU against the true masks", iou, "≥ 0.95", iou >= 0.95);
+    let mpjpe = m(|r| r.1);
+    line("PA-MPJPE, 24 joints (mm)", mpjpe, "≤ 50", mpjpe <= 50.0);
+    let pve = m(|r| r.2);
+    line("per-vertex error under the clothes, aligned (mm)", pve, "≤ 25", pve <= 25.0);
+    let one = m(|r| r.3);
+    line("fit on one image, models loaded (s)", one, "≤ 2", one <= 2.0);
+    let clip = m(|r| r.4);
+    line("capture of 120 frames (s, landmarks + fit)", clip, "≤ 120", clip <= 120.0);
+}
