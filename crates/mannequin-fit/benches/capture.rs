@@ -9,7 +9,7 @@
 //! them, as PA-MPJPE is defined); and the time. One more `fit` of a single frame, models
 //! loaded afresh, times the one-image path.
 //!
-//! `cargo bench -p mannequin-fit --bench capture -- [--seed S] [--subjects N] [--frames F]`
+//! `cargo bench -p mannequin-fit --bench capture -- [--seed S] [--subjects N] [--frames F] [--per-frame]`
 
 use std::time::Instant;
 
@@ -105,6 +105,7 @@ fn main() {
         let clip = start.elapsed().as_secs_f64();
 
         let (mut iou, mut mpjpe, mut pve) = (0.0, 0.0, 0.0);
+        let mut per_frame = Vec::with_capacity(n);
         for (i, (frame, fit)) in frames.iter().zip(&fits).enumerate() {
             let mask: Vec<bool> = people[i].mask.iter().map(|&p| p > 0.5).collect();
             let inter = mask.iter().zip(&frame.mask.values).filter(|(a, b)| **a && **b).count();
@@ -113,15 +114,22 @@ fn main() {
             let (tj, tv) =
                 in_camera(&model, &truth.betas, &truth.pose72(i), &truth.transl[i], dataset.camera(i));
             let (fj, fv) = in_camera(&model, &fit.betas, &fit.pose, &fit.transl, &fit.camera);
-            mpjpe += aligned_error(&fj, &tj);
-            pve += aligned_error(&fv, &tv);
+            let (e_j, e_v) = (aligned_error(&fj, &tj), aligned_error(&fv, &tv));
+            if std::env::args().any(|a| a == "--per-frame") {
+                println!("  frame {i:3}: PA-MPJPE {:.1} mm, per-vertex {:.1} mm", 1000.0 * e_j, 1000.0 * e_v);
+            }
+            mpjpe += e_j;
+            per_frame.push(e_j);
+            pve += e_v;
         }
         let k = n as f64;
+        per_frame.sort_by(f64::total_cmp);
         println!(
-            "seed {subject} ({:?}, {n} frames at {width}×{height}): mask IoU {:.3}, PA-MPJPE {:.1} mm, per-vertex {:.1} mm, one image {one_image:.2} s, clip {clip:.1} s",
+            "seed {subject} ({:?}, {n} frames at {width}×{height}): mask IoU {:.3}, PA-MPJPE {:.1} mm (median frame {:.1}), per-vertex {:.1} mm, one image {one_image:.2} s, clip {clip:.1} s",
             summary.subject.outfit,
             iou / k,
             1000.0 * mpjpe / k,
+            1000.0 * per_frame[n / 2],
             1000.0 * pve / k
         );
         rows.push((iou / k, 1000.0 * mpjpe / k, 1000.0 * pve / k, one_image, clip * 120.0 / k));

@@ -39,7 +39,12 @@ impl<'a> Tracker<'a> {
             Some(l) => Some(l),
             None => {
                 let everyone = self.models.people(image)?;
-                if everyone.is_empty() { None } else { Some(pick_person(&everyone, None)?.landmarks.clone()) }
+                match everyone.is_empty() {
+                    true => None,
+                    false => {
+                        Some(self.models.refine(image, pick_person(&everyone, None)?.landmarks.clone())?)
+                    }
+                }
             }
         };
         self.previous.clone_from(&found);

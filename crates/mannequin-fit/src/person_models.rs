@@ -54,6 +54,14 @@ impl PersonModels {
         Ok(out)
     }
 
+    /// The landmarks read again in the crop they themselves point to: the detector's crop is
+    /// set by two keypoints alone, the landmarks' by the whole body, as MediaPipe crops every
+    /// video frame after the first. Kept when the landmarker is at least as sure of them.
+    pub fn refine(&self, image: &Image, landmarks: PoseLandmarks) -> Result<PoseLandmarks, FitError> {
+        let again = estimate(&self.landmarker, image, landmarks.next_roi)?;
+        Ok(if again.flag >= landmarks.flag { again } else { landmarks })
+    }
+
     /// The same person in the next video frame, read in the crop their landmarks in the previous
     /// frame point to (MediaPipe's tracking); None once the landmarker loses them.
     pub fn follow(&self, image: &Image, previous: &PoseLandmarks) -> Result<Option<PoseLandmarks>, FitError> {

@@ -79,12 +79,13 @@ pub fn run(args: Args) -> Result<()> {
     let models = PersonModels::load()?;
     let people = models.people(&image)?;
     let person = pick_person(&people, args.person).with_context(|| args.image.display().to_string())?;
+    let landmarks = models.refine(&image, person.landmarks.clone())?;
     let focal = args.fitting.focal(image.width, image.height);
-    let fit = fit_body(&model, &person.landmarks, image.width, image.height, focal)
+    let fit = fit_body(&model, &landmarks, image.width, image.height, focal)
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let mesh = posed_mesh(&model, &fit)?;
-    let (picture, iou) = check_picture(&image, &mesh, &person.landmarks, &fit);
+    let (picture, iou) = check_picture(&image, &mesh, &landmarks, &fit);
     write_body_npz(&args.out.join("body.npz"), &fit)?;
     crate::body::write_mesh(&args.out.join("body.obj"), &mesh)?;
     write_glb(&args.out.join("body.glb"), &model, &fit)?;
