@@ -45,14 +45,9 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "../../../tools/bench_args.rs"]
+mod bench_args;
+use bench_args::arg;
 
 /// Iterations timed for the breakdown: the last ones, at full resolution (the first ones run at
 /// half resolution), and never the first 3, which warm up.

@@ -21,14 +21,9 @@ use mannequin_mesh::ring_tube::RingLayout;
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-fn arg(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "../../../tools/bench_args.rs"]
+mod bench_args;
+use bench_args::arg;
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3

@@ -22,14 +22,9 @@ use mannequin_fit::rigid_alignment::best_rotation;
 use mannequin_fit::{PersonModels, fit_body};
 use mannequin_synth::{SynthOptions, generate};
 
-fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "../../../tools/bench_args.rs"]
+mod bench_args;
+use bench_args::arg;
 
 /// Mean distance between `a` and `b` once `a` is moved onto `b` by the best similarity.
 fn aligned_error(a: &[DVec3], b: &[DVec3]) -> f64 {
