@@ -93,6 +93,16 @@ impl Mask {
         self.values[y * self.width + x]
     }
 
+    /// Intersection over union with a mask of the same size (0 when both are empty).
+    pub fn iou(&self, other: &Mask) -> f64 {
+        let (mut inter, mut union) = (0usize, 0usize);
+        for (a, b) in self.values.iter().zip(&other.values) {
+            inter += (*a && *b) as usize;
+            union += (*a || *b) as usize;
+        }
+        if union == 0 { 0.0 } else { inter as f64 / union as f64 }
+    }
+
     pub fn count(&self) -> usize {
         self.values.iter().filter(|&&m| m).count()
     }
@@ -115,6 +125,14 @@ impl Mask {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn iou_counts_shared_pixels_over_covered_ones() {
+        let m = |v: [bool; 4]| Mask { width: 2, height: 2, values: v.to_vec() };
+        // 1 pixel in both, 3 in either.
+        assert_eq!(m([true, true, false, false]).iou(&m([false, true, true, false])), 1.0 / 3.0);
+        assert_eq!(m([false; 4]).iou(&m([false; 4])), 0.0);
+    }
 
     #[test]
     fn png_round_trip_is_exact_after_quantisation() {

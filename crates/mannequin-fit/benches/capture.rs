@@ -102,10 +102,7 @@ fn main() {
         let (mut iou, mut mpjpe, mut pve) = (0.0, 0.0, 0.0);
         let mut per_frame = Vec::with_capacity(n);
         for (i, (frame, fit)) in frames.iter().zip(&fits).enumerate() {
-            let mask: Vec<bool> = people[i].mask.iter().map(|&p| p > 0.5).collect();
-            let inter = mask.iter().zip(&frame.mask.values).filter(|(a, b)| **a && **b).count();
-            let union = mask.iter().zip(&frame.mask.values).filter(|(a, b)| **a || **b).count();
-            iou += inter as f64 / union.max(1) as f64;
+            iou += people[i].person_mask(width, height).iou(&frame.mask);
             let (tj, tv) =
                 in_camera(&model, &truth.betas, &truth.pose72(i), &truth.transl[i], dataset.camera(i));
             let (fj, fv) = in_camera(&model, &fit.betas, &fit.pose, &fit.transl, &fit.camera);

@@ -70,6 +70,15 @@ pub struct BodyFit {
     pub stages: Vec<Summary>,
 }
 
+impl BodyFit {
+    /// The median of the confident landmarks' reprojection errors, in pixels.
+    pub fn median_error_px(&self) -> Option<f32> {
+        let mut e: Vec<f32> = self.errors_px.iter().flatten().copied().collect();
+        e.sort_by(f32::total_cmp);
+        e.get(e.len() / 2).copied()
+    }
+}
+
 /// The world → camera turn: half a turn about x, so world Y-up and camera y-down agree.
 fn flip(p: DVec3) -> DVec3 {
     DVec3::new(p.x, -p.y, -p.z)
@@ -222,7 +231,7 @@ impl Fitter {
                 format!("{} given, expected {NUM_LANDMARKS}", person.points.len()),
             ));
         }
-        let inside: Vec<bool> = person.mask.iter().map(|&p| p > 0.5).collect();
+        let inside = person.person_mask(width, height).values;
         Ok(Observed {
             points: person.points.iter().map(|p| [p[0] as f64, p[1] as f64]).collect(),
             world: person.world.iter().map(|w| DVec3::new(w[0] as f64, w[1] as f64, w[2] as f64)).collect(),
@@ -310,6 +319,39 @@ impl Fitter {
             stages,
         }
     }
+
+    /// The starting parameters: the relaxed stance, turned and placed onto the landmarks.
+    fn initial_parameters(&self, observed: &Observed) -> Result<Vec<f64>, FitError> {
+        let Self { body, layout, camera, relaxed, .. } = self;
+        let mut p = vec![0.0; layout.len()];
+        p[3..Layout::POSE].copy_from_slice(relaxed);
+        let betas = vec![0.0f32; layout.betas];
+        let rest = body.rest_joints(&betas);
+        let torso = [
+            (LEFT_HIP, L_HIP),
+            (RIGHT_HIP, R_HIP),
+            (LEFT_SHOULDER, L_SHOULDER),
+            (RIGHT_SHOULDER, R_SHOULDER),
+        ];
+        let a: Vec<DVec3> = torso.iter().map(|&(_, j)| rest[j].as_dvec3()).collect();
+        let b: Vec<DVec3> = torso.iter().map(|&(i, _)| flip(observed.world[i])).collect();
+        let w: Vec<f64> = torso.iter().map(|&(i, _)| observed.confidence[i].max(1e-3)).collect();
+        let rotation = best_rotation(&a, &b, &w).ok_or_else(|| {
+            FitError::input("landmarks", "the hips and shoulders do not fix the body's orientation")
+        })?;
+        let q = glam::Quat::from_mat3(&DMat3::as_mat3(&rotation)).normalize();
+        let global = quat_axis_angle(q);
+        p[..3].copy_from_slice(&global.map(|v| v as f64));
+        let hips_cam = hip_position(observed, camera)
+            .ok_or_else(|| FitError::input("landmarks", "too few confident landmarks to place the body"))?;
+        let hips_world = flip(hips_cam);
+        let hip_rest = (rest[L_HIP] + rest[R_HIP]).as_dvec3() / 2.0;
+        let pelvis = rest[PELVIS].as_dvec3();
+        let turned = DMat3::from_quat(axis_angle_quat(global).as_dquat());
+        let t = hips_world - pelvis - turned * (hip_rest - pelvis);
+        p[layout.transl()..].copy_from_slice(&t.to_array());
+        Ok(p)
+    }
 }
 
 /// One frame's residuals: the fitter, what it sees, and an optional pull toward earlier
@@ -368,41 +410,6 @@ impl Problem<'_> {
             r.extend(moving.map(|i| w * (p[i] - q[i])));
         }
         r
-    }
-}
-
-impl Fitter {
-    /// The starting parameters: the relaxed stance, turned and placed onto the landmarks.
-    fn initial_parameters(&self, observed: &Observed) -> Result<Vec<f64>, FitError> {
-        let Self { body, layout, camera, relaxed, .. } = self;
-        let mut p = vec![0.0; layout.len()];
-        p[3..Layout::POSE].copy_from_slice(relaxed);
-        let betas = vec![0.0f32; layout.betas];
-        let rest = body.rest_joints(&betas);
-        let torso = [
-            (LEFT_HIP, L_HIP),
-            (RIGHT_HIP, R_HIP),
-            (LEFT_SHOULDER, L_SHOULDER),
-            (RIGHT_SHOULDER, R_SHOULDER),
-        ];
-        let a: Vec<DVec3> = torso.iter().map(|&(_, j)| rest[j].as_dvec3()).collect();
-        let b: Vec<DVec3> = torso.iter().map(|&(i, _)| flip(observed.world[i])).collect();
-        let w: Vec<f64> = torso.iter().map(|&(i, _)| observed.confidence[i].max(1e-3)).collect();
-        let rotation = best_rotation(&a, &b, &w).ok_or_else(|| {
-            FitError::input("landmarks", "the hips and shoulders do not fix the body's orientation")
-        })?;
-        let q = glam::Quat::from_mat3(&DMat3::as_mat3(&rotation)).normalize();
-        let global = quat_axis_angle(q);
-        p[..3].copy_from_slice(&global.map(|v| v as f64));
-        let hips_cam = hip_position(observed, camera)
-            .ok_or_else(|| FitError::input("landmarks", "too few confident landmarks to place the body"))?;
-        let hips_world = flip(hips_cam);
-        let hip_rest = (rest[L_HIP] + rest[R_HIP]).as_dvec3() / 2.0;
-        let pelvis = rest[PELVIS].as_dvec3();
-        let turned = DMat3::from_quat(axis_angle_quat(global).as_dquat());
-        let t = hips_world - pelvis - turned * (hip_rest - pelvis);
-        p[layout.transl()..].copy_from_slice(&t.to_array());
-        Ok(p)
     }
 }
 
@@ -531,11 +538,7 @@ mod tests {
             .zip(got.joints.chunks_exact(3))
             .map(|(a, b)| Vec3::from_slice(a).distance(Vec3::from_slice(b)))
             .fold(0.0f32, f32::max);
-        let median = {
-            let mut e: Vec<f32> = fit.errors_px.iter().flatten().copied().collect();
-            e.sort_by(f32::total_cmp);
-            e[e.len() / 2]
-        };
+        let median = fit.median_error_px().unwrap();
         assert!(median < 1.0, "median reprojection error {median} px");
         assert!(joint_error < 0.05, "worst joint {joint_error} m from the truth");
     }

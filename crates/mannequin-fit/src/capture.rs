@@ -8,6 +8,7 @@
 use mannequin_data::Image;
 
 use crate::body_fit::{Anchor, BodyFit, Fitter};
+use crate::crop::RotatedRect;
 use crate::error::FitError;
 use crate::person_models::{PersonModels, pick_person};
 use crate::pose_landmarker::PoseLandmarks;
@@ -21,18 +22,19 @@ const SMOOTHNESS: f64 = 2.0;
 /// Follows one person from frame to frame.
 pub struct Tracker<'a> {
     models: &'a PersonModels,
-    previous: Option<PoseLandmarks>,
+    /// Where the last frame's landmarks put the person next.
+    next_roi: Option<RotatedRect>,
 }
 
 impl<'a> Tracker<'a> {
     pub fn new(models: &'a PersonModels) -> Self {
-        Self { models, previous: None }
+        Self { models, next_roi: None }
     }
 
     /// The person's landmarks in the next frame; None when nobody is there.
     pub fn next(&mut self, image: &Image) -> Result<Option<PoseLandmarks>, FitError> {
-        let followed = match &self.previous {
-            Some(p) => self.models.follow(image, p)?,
+        let followed = match self.next_roi {
+            Some(roi) => self.models.follow(image, roi)?,
             None => None,
         };
         let found = match followed {
@@ -47,7 +49,7 @@ impl<'a> Tracker<'a> {
                 }
             }
         };
-        self.previous.clone_from(&found);
+        self.next_roi = found.as_ref().map(|l| l.next_roi);
         Ok(found)
     }
 }

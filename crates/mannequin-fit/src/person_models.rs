@@ -4,7 +4,7 @@
 
 use mannequin_data::Image;
 
-use crate::crop::{Border, crop, uncrop};
+use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
 use crate::network::Network;
 use crate::pose_detector::{Detection, detect, letterbox};
@@ -63,9 +63,9 @@ impl PersonModels {
     }
 
     /// The same person in the next video frame, read in the crop their landmarks in the previous
-    /// frame point to (MediaPipe's tracking); None once the landmarker loses them.
-    pub fn follow(&self, image: &Image, previous: &PoseLandmarks) -> Result<Option<PoseLandmarks>, FitError> {
-        let landmarks = estimate(&self.landmarker, image, previous.next_roi)?;
+    /// frame point to (`next_roi`, MediaPipe's tracking); None once the landmarker loses them.
+    pub fn follow(&self, image: &Image, roi: RotatedRect) -> Result<Option<PoseLandmarks>, FitError> {
+        let landmarks = estimate(&self.landmarker, image, roi)?;
         Ok((landmarks.flag >= MIN_POSE_FLAG).then_some(landmarks))
     }
 

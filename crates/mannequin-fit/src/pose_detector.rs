@@ -9,6 +9,7 @@ use mannequin_data::Image;
 use crate::crop::{Border, RotatedRect, crop};
 use crate::error::FitError;
 use crate::network::Network;
+use crate::pose_landmarker::sigmoid;
 use crate::ssd_anchors::anchors;
 
 pub const INPUT_SIZE: usize = 224;
@@ -68,7 +69,7 @@ pub fn decode(regressors: &[f32], scores: &[f32]) -> Vec<Detection> {
         .zip(regressors.chunks_exact(4 + 2 * KEYPOINTS))
         .zip(scores)
         .filter_map(|((a, r), &s)| {
-            let score = 1.0 / (1.0 + (-s.clamp(-SCORE_CLIP, SCORE_CLIP)).exp());
+            let score = sigmoid(s.clamp(-SCORE_CLIP, SCORE_CLIP));
             (score >= MIN_SCORE).then(|| {
                 let (cx, cy) = (r[0] / scale + a[0], r[1] / scale + a[1]);
                 let (w, h) = (r[2] / scale, r[3] / scale);

@@ -3,7 +3,7 @@
 //! refinement, then the crop's rotation and scale undone). The crop comes from a detection's
 //! keypoints or, in video, from the previous frame's auxiliary landmarks.
 
-use mannequin_data::Image;
+use mannequin_data::{Image, Mask};
 
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
@@ -43,7 +43,14 @@ pub struct PoseLandmarks {
     pub mask: Vec<f32>,
 }
 
-fn sigmoid(x: f32) -> f32 {
+impl PoseLandmarks {
+    /// The person's mask as pixels: probability above one half.
+    pub fn person_mask(&self, width: usize, height: usize) -> Mask {
+        Mask { width, height, values: self.mask.iter().map(|&p| p > 0.5).collect() }
+    }
+}
+
+pub(crate) fn sigmoid(x: f32) -> f32 {
     1.0 / (1.0 + (-x).exp())
 }
 

@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use mannequin_body::BodyModel;
 use mannequin_data::layout::IMAGE_EXTENSIONS;
 use mannequin_data::splits::SplitRange;
-use mannequin_data::{Cameras, DatasetWriter, Frame, Image, Mask, Poses, Splits};
+use mannequin_data::{Cameras, DatasetWriter, Frame, Image, Poses, Splits};
 use mannequin_fit::body_fit::Fitter;
 use mannequin_fit::capture::{Tracker, fit_clip, fit_clip_steps};
 use mannequin_fit::pose_landmarker::PoseLandmarks;
@@ -185,11 +185,7 @@ fn write_dataset(
     }
     let progress = bar(kept.len() as u64, "writing");
     for (index, ((_, image), person)) in kept.iter().zip(people).enumerate() {
-        let mask = Mask {
-            width: image.width,
-            height: image.height,
-            values: person.mask.iter().map(|&p| p > 0.5).collect(),
-        };
+        let mask = person.person_mask(image.width, image.height);
         writer.write_frame(&Frame { index, image: image.clone(), mask, normals: None, depth: None })?;
         progress.inc(1);
     }
@@ -245,15 +241,10 @@ fn report(
     focal: f64,
     seconds: f64,
 ) -> serde_json::Value {
-    let median = |f: &BodyFit| {
-        let mut e: Vec<f32> = f.errors_px.iter().flatten().copied().collect();
-        e.sort_by(f32::total_cmp);
-        e.get(e.len() / 2).copied()
-    };
     serde_json::json!({
         "frames": kept.iter().zip(fits).zip(ious).map(|(((file, _), f), iou)| serde_json::json!({
             "source": file.display().to_string(),
-            "median_landmark_error_px": median(f),
+            "median_landmark_error_px": f.median_error_px(),
             "mask_iou": iou,
         })).collect::<Vec<_>>(),
         "mean_mask_iou": ious.iter().sum::<f64>() / ious.len() as f64,

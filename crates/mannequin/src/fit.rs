@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use mannequin_body::{BodyModel, forward, skeletal_animation, skinned_body};
+use mannequin_data::Image;
 use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
-use mannequin_data::{Image, Mask};
 use mannequin_fit::body_fit::assumed_focal;
 use mannequin_fit::overlay::overlay;
 use mannequin_fit::pose_landmarker::PoseLandmarks;
@@ -113,16 +113,9 @@ pub fn check_picture(
     fit: &BodyFit,
 ) -> (Image, f64) {
     let raster = render(mesh, fit);
-    let person = Mask {
-        width: image.width,
-        height: image.height,
-        values: landmarks.mask.iter().map(|&p| p > 0.5).collect(),
-    };
+    let person = landmarks.person_mask(image.width, image.height);
     let confident: Vec<bool> = fit.errors_px.iter().map(Option::is_some).collect();
-    (
-        overlay(image, &raster, &landmarks.points, &confident, &fit.reprojected),
-        mask_iou(&raster.mask, &person),
-    )
+    (overlay(image, &raster, &landmarks.points, &confident, &fit.reprojected), raster.mask.iou(&person))
 }
 
 pub fn posed_mesh(model: &BodyModel, fit: &BodyFit) -> Result<TriMesh> {
@@ -141,15 +134,6 @@ fn render(mesh: &TriMesh, fit: &BodyFit) -> mannequin_data::mesh_raster::Raster 
         shading: Shading::Flat([1.0; 3]),
     };
     rasterize(&raster_mesh, &fit.camera, [0.0; 3])
-}
-
-fn mask_iou(a: &Mask, b: &Mask) -> f64 {
-    let (mut inter, mut union) = (0usize, 0usize);
-    for (x, y) in a.values.iter().zip(&b.values) {
-        inter += (*x && *y) as usize;
-        union += (*x || *y) as usize;
-    }
-    if union == 0 { 0.0 } else { inter as f64 / union as f64 }
 }
 
 /// SMPL's layout as PeopleSnapshot's pose files have it (one frame), plus the camera as its
@@ -177,17 +161,16 @@ fn write_glb(path: &Path, model: &BodyModel, fit: &BodyFit) -> Result<()> {
 }
 
 fn report(fit: &BodyFit, person: &Person, iou: f64, focal: f64, seconds: f64) -> serde_json::Value {
-    let mut errors: Vec<f32> = fit.errors_px.iter().flatten().copied().collect();
-    errors.sort_by(f32::total_cmp);
-    let median = errors.get(errors.len() / 2).copied().unwrap_or(f32::NAN);
+    let errors: Vec<f32> = fit.errors_px.iter().flatten().copied().collect();
     let mean = errors.iter().sum::<f32>() / errors.len().max(1) as f32;
+    let max = errors.iter().copied().reduce(f32::max);
     let per_landmark: serde_json::Map<String, serde_json::Value> = mannequin_fit::blazepose::LANDMARKS
         .iter()
         .zip(&fit.errors_px)
         .map(|((name, _), e)| (name.to_string(), e.map_or(serde_json::Value::Null, |e| serde_json::json!(e))))
         .collect();
     serde_json::json!({
-        "landmark_error_px": { "mean": mean, "median": median, "max": errors.last(), "per_landmark": per_landmark },
+        "landmark_error_px": { "mean": mean, "median": fit.median_error_px(), "max": max, "per_landmark": per_landmark },
         "mask_iou": iou,
         "seconds": seconds,
         "focal_px": focal,
