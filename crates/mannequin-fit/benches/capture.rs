@@ -2,8 +2,8 @@
 //! in simulated cloth and rendered by `mannequin-synth`, whose frames go in as plain images (no
 //! poses, masks or cameras), and whose true bodies the result is compared with.
 //!
-//! Per subject: the person models and the clip fit run on the turning capture's frames, with the
-//! focal length assumed as `capture` assumes it. Then, per frame: the mask's IoU against the true
+//! Per subject: the person models, the mirror resolution and the clip fit run on the turning
+//! capture's frames, with the focal length assumed as `capture` assumes it. Then, per frame: the mask's IoU against the true
 //! mask; PA-MPJPE over the 24 joints and the per-vertex error of the fitted body against the
 //! true body under the clothes (both in camera space, after the similarity that best aligns
 //! them, as PA-MPJPE is defined); and the time. One more `fit` of a single frame, models
@@ -17,7 +17,7 @@ use glam::DVec3;
 use mannequin_body::BodyModel;
 use mannequin_data::{Camera, Dataset, Poses};
 use mannequin_fit::body_fit::{Fitter, assumed_focal};
-use mannequin_fit::capture::{Tracker, fit_clip};
+use mannequin_fit::capture::{Tracker, fit_clip, resolve_mirrors};
 use mannequin_fit::rigid_alignment::best_rotation;
 use mannequin_fit::{PersonModels, fit_body};
 use mannequin_synth::{SynthOptions, generate};
@@ -93,9 +93,10 @@ fn main() {
 
         let start = Instant::now();
         let mut tracker = Tracker::new(&models);
-        let people: Vec<_> =
+        let mut people: Vec<_> =
             frames.iter().map(|f| tracker.next(&f.image).expect("landmarks").expect("the person")).collect();
         let fitter = Fitter::new(&model, width, height, assumed_focal(width, height)).expect("fitter");
+        let mirrored = resolve_mirrors(&fitter, &mut people).len();
         let fits = fit_clip(&fitter, &people, &mut || {}).expect("clip");
         let clip = start.elapsed().as_secs_f64();
 
@@ -117,7 +118,7 @@ fn main() {
         let k = n as f64;
         per_frame.sort_by(f64::total_cmp);
         println!(
-            "seed {subject} ({:?}, {n} frames at {width}×{height}): mask IoU {:.3}, PA-MPJPE {:.1} mm (median frame {:.1}), per-vertex {:.1} mm, one image {one_image:.2} s, clip {clip:.1} s",
+            "seed {subject} ({:?}, {n} frames at {width}×{height}, {mirrored} read mirrored): mask IoU {:.3}, PA-MPJPE {:.1} mm (median frame {:.1}), per-vertex {:.1} mm, one image {one_image:.2} s, clip {clip:.1} s",
             summary.subject.outfit,
             iou / k,
             1000.0 * mpjpe / k,

@@ -56,6 +56,15 @@ pub const LANDMARKS: [(&str, Anchor); 33] = [
     ("right_foot_index", Anchor::Vertex(4933)),
 ];
 
+/// The landmark on the other side of the body: the same name with left and right swapped
+/// (itself for the nose).
+pub fn mirror(i: usize) -> usize {
+    let name = LANDMARKS[i].0;
+    let other =
+        if name.contains("left") { name.replace("left", "right") } else { name.replace("right", "left") };
+    LANDMARKS.iter().position(|(n, _)| *n == other).unwrap_or(i)
+}
+
 /// The vertex count of the body the table's vertices index.
 pub const DEFAULT_BODY_VERTICES: usize = 13380;
 
@@ -96,6 +105,22 @@ mod tests {
         match LANDMARKS.iter().find(|(n, _)| *n == name).unwrap().1 {
             Anchor::Vertex(v) => m.v_template[v],
             other => panic!("{name} is {other:?}"),
+        }
+    }
+
+    #[test]
+    fn mirror_pairs_each_side_with_the_other() {
+        for (i, &(a, _)) in LANDMARKS.iter().enumerate() {
+            let j = mirror(i);
+            assert_eq!(mirror(j), i);
+            let b = LANDMARKS[j].0;
+            match i {
+                0 => assert_eq!(j, 0, "the nose is its own mirror"),
+                _ => assert!(
+                    a != b && a.replace("left", "right") == b || a.replace("right", "left") == b,
+                    "{a} ↔ {b}"
+                ),
+            }
         }
     }
 

@@ -19,7 +19,7 @@
 //! runs in three stages: rotation and translation alone, everything under a strong prior, then
 //! under the final prior.
 
-use glam::{DMat3, DVec3, Vec3};
+use glam::{DMat3, DQuat, DVec3, Vec3};
 use mannequin_body::BodyModel;
 use mannequin_body::rodrigues::{axis_angle_quat, quat_axis_angle};
 use mannequin_body::smpl_joint::{L_HIP, L_SHOULDER, PELVIS, R_HIP, R_SHOULDER};
@@ -70,13 +70,64 @@ pub struct BodyFit {
     pub stages: Vec<Summary>,
 }
 
+/// A body's pose and placement in one frame, its shape held elsewhere.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FramePose {
+    /// SMPL layout: 24 × axis-angle, global orientation first.
+    pub pose: Vec<f32>,
+    pub transl: [f32; 3],
+}
+
 impl BodyFit {
+    pub fn frame_pose(&self) -> FramePose {
+        FramePose { pose: self.pose.clone(), transl: self.transl }
+    }
+
     /// The median of the confident landmarks' reprojection errors, in pixels.
     pub fn median_error_px(&self) -> Option<f32> {
         let mut e: Vec<f32> = self.errors_px.iter().flatten().copied().collect();
         e.sort_by(f32::total_cmp);
         e.get(e.len() / 2).copied()
     }
+}
+
+/// Each landmark's weight: visibility × presence, zero below [`MIN_CONFIDENCE`].
+fn confidence(person: &PoseLandmarks) -> Vec<f64> {
+    person
+        .visibility
+        .iter()
+        .zip(&person.presence)
+        .map(|(v, p)| {
+            let c = v * p;
+            if c >= MIN_CONFIDENCE { c as f64 } else { 0.0 }
+        })
+        .collect()
+}
+
+/// The global orientation that turns the body's rest hips and shoulders onto the world
+/// landmarks' (camera axes, turned to the world's): where the landmarker says the person faces.
+fn torso_orientation(rest: &[Vec3], world: &[DVec3], confidence: &[f64]) -> Option<DQuat> {
+    let torso =
+        [(LEFT_HIP, L_HIP), (RIGHT_HIP, R_HIP), (LEFT_SHOULDER, L_SHOULDER), (RIGHT_SHOULDER, R_SHOULDER)];
+    let a: Vec<DVec3> = torso.iter().map(|&(_, j)| rest[j].as_dvec3()).collect();
+    let b: Vec<DVec3> = torso.iter().map(|&(i, _)| flip(world[i])).collect();
+    let w: Vec<f64> = torso.iter().map(|&(i, _)| confidence[i].max(1e-3)).collect();
+    best_rotation(&a, &b, &w).map(|r| DQuat::from_mat3(&r).normalize())
+}
+
+/// The rotation vector taking `from` to `to` the short way (world frame): a difference of
+/// orientations that does not jump where axis-angle wraps at half a turn.
+pub fn rotation_gap(from: DQuat, to: DQuat) -> DVec3 {
+    let mut q = to * from.conjugate();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    let s = q.xyz().length();
+    if s < 1e-12 { 2.0 * q.xyz() } else { 2.0 * s.atan2(q.w) / s * q.xyz() }
+}
+
+fn orientation(p: &[f64]) -> DQuat {
+    axis_angle_quat([p[0] as f32, p[1] as f32, p[2] as f32]).as_dquat()
 }
 
 /// The world → camera turn: half a turn about x, so world Y-up and camera y-down agree.
@@ -168,11 +219,12 @@ pub struct Fitter {
 }
 
 /// A pull toward earlier parameters (the previous video frame), with its weight per radian and
-/// per metre.
+/// per metre, and optionally toward an orientation the clip's landmarks agree on.
 pub struct Anchor<'a> {
-    pub pose: &'a [f32],
-    pub transl: [f32; 3],
+    pub at: &'a FramePose,
     pub weight: f64,
+    /// Where the body faces, and that pull's weight per radian; the fit starts from it.
+    pub facing: Option<(DQuat, f64)>,
 }
 
 impl Fitter {
@@ -235,15 +287,7 @@ impl Fitter {
         Ok(Observed {
             points: person.points.iter().map(|p| [p[0] as f64, p[1] as f64]).collect(),
             world: person.world.iter().map(|w| DVec3::new(w[0] as f64, w[1] as f64, w[2] as f64)).collect(),
-            confidence: person
-                .visibility
-                .iter()
-                .zip(&person.presence)
-                .map(|(v, p)| {
-                    let c = v * p;
-                    if c >= MIN_CONFIDENCE { c as f64 } else { 0.0 }
-                })
-                .collect(),
+            confidence: confidence(person),
             unit_px: PIXEL_UNIT * person.roi.width as f64,
             outside: inside.iter().any(|&b| b).then(|| distance_to(&inside, width, height)),
             width,
@@ -277,15 +321,76 @@ impl Fitter {
     ) -> Result<BodyFit, FitError> {
         let observed = self.observe(person)?;
         let layout = &self.layout;
-        let mut params = vec![0.0; layout.len()];
-        params[..Layout::POSE].iter_mut().zip(anchor.pose).for_each(|(p, &v)| *p = v as f64);
-        params[Layout::POSE..layout.transl()].iter_mut().zip(betas).for_each(|(p, &b)| *p = b as f64);
-        params[layout.transl()..].iter_mut().zip(anchor.transl).for_each(|(p, t)| *p = t as f64);
+        let mut params = self.parameters(anchor.at, betas);
         let pulled: Vec<f64> = params.clone();
-        let problem = Problem { fitter: self, observed: &observed, anchor: Some((&pulled, anchor.weight)) };
+        if let Some((q, _)) = anchor.facing {
+            let start = quat_axis_angle(q.as_quat());
+            params[..3].iter_mut().zip(start).for_each(|(p, v)| *p = v as f64);
+        }
+        let pull = Pull { params: &pulled, weight: anchor.weight, facing: anchor.facing };
+        let problem = Problem { fitter: self, observed: &observed, anchor: Some(pull) };
         let free: Vec<usize> = (0..Layout::POSE).chain(layout.transl()..layout.len()).collect();
         let stages = vec![minimise(&|p| problem.residuals(p, REST_WEIGHT), &mut params, &free, 40, 1e-4)];
         Ok(self.result(&params, &observed, stages))
+    }
+
+    /// The parameter vector of a frame's pose and placement with the shape `betas`.
+    fn parameters(&self, frame: &FramePose, betas: &[f32]) -> Vec<f64> {
+        let layout = &self.layout;
+        let mut p = vec![0.0; layout.len()];
+        p[..Layout::POSE].iter_mut().zip(&frame.pose).for_each(|(p, &v)| *p = v as f64);
+        p[Layout::POSE..layout.transl()].iter_mut().zip(betas).for_each(|(p, &b)| *p = b as f64);
+        p[layout.transl()..].iter_mut().zip(frame.transl).for_each(|(p, t)| *p = t as f64);
+        p
+    }
+
+    /// The fit as it stands at a given shape, pose and placement (nothing is solved): its
+    /// reprojections and errors against `person`.
+    pub fn at(&self, person: &PoseLandmarks, betas: &[f32], frame: &FramePose) -> Result<BodyFit, FitError> {
+        let observed = self.observe(person)?;
+        Ok(self.result(&self.parameters(frame, betas), &observed, Vec::new()))
+    }
+
+    /// One shape for several frames whose poses and placements are held: Levenberg–Marquardt on
+    /// the shape alone, over all the frames' residuals at once, starting from `betas`.
+    pub fn fit_shape(
+        &self,
+        frames: &[(&PoseLandmarks, &FramePose)],
+        betas: &[f32],
+    ) -> Result<Vec<f32>, FitError> {
+        let layout = &self.layout;
+        let observed =
+            frames.iter().map(|(person, _)| self.observe(person)).collect::<Result<Vec<_>, _>>()?;
+        let mut shape: Vec<f64> = betas.iter().map(|&b| b as f64).collect();
+        let residuals = |shape: &[f64]| -> Vec<f64> {
+            let mut r = Vec::new();
+            for (o, (_, frame)) in observed.iter().zip(frames) {
+                let problem = Problem { fitter: self, observed: o, anchor: None };
+                let mut p = self.parameters(frame, &[]);
+                p[Layout::POSE..layout.transl()].copy_from_slice(shape);
+                let frame = problem.residuals(&p, REST_WEIGHT);
+                // The shape prior is in every frame's residuals; count it once.
+                let n = frame.len() - layout.betas;
+                r.extend_from_slice(&frame[..n]);
+            }
+            r.extend(shape.iter().map(|b| SHAPE_WEIGHT * b));
+            r
+        };
+        let all: Vec<usize> = (0..layout.betas).collect();
+        minimise(&residuals, &mut shape, &all, 20, 1e-4);
+        Ok(shape.iter().map(|&b| b as f32).collect())
+    }
+
+    /// Where the landmarker says the person faces: the global orientation that turns the rest
+    /// body's hips and shoulders onto the world landmarks. None when they do not fix it.
+    pub fn facing(&self, person: &PoseLandmarks) -> Option<DQuat> {
+        if person.world.len() != NUM_LANDMARKS || person.visibility.len() != NUM_LANDMARKS {
+            return None;
+        }
+        let rest = self.body.rest_joints(&vec![0.0; self.layout.betas]);
+        let world: Vec<DVec3> =
+            person.world.iter().map(|w| DVec3::new(w[0] as f64, w[1] as f64, w[2] as f64)).collect();
+        torso_orientation(&rest, &world, &confidence(person))
     }
 
     fn result(&self, params: &[f64], observed: &Observed, stages: Vec<Summary>) -> BodyFit {
@@ -327,20 +432,10 @@ impl Fitter {
         p[3..Layout::POSE].copy_from_slice(relaxed);
         let betas = vec![0.0f32; layout.betas];
         let rest = body.rest_joints(&betas);
-        let torso = [
-            (LEFT_HIP, L_HIP),
-            (RIGHT_HIP, R_HIP),
-            (LEFT_SHOULDER, L_SHOULDER),
-            (RIGHT_SHOULDER, R_SHOULDER),
-        ];
-        let a: Vec<DVec3> = torso.iter().map(|&(_, j)| rest[j].as_dvec3()).collect();
-        let b: Vec<DVec3> = torso.iter().map(|&(i, _)| flip(observed.world[i])).collect();
-        let w: Vec<f64> = torso.iter().map(|&(i, _)| observed.confidence[i].max(1e-3)).collect();
-        let rotation = best_rotation(&a, &b, &w).ok_or_else(|| {
+        let q = torso_orientation(&rest, &observed.world, &observed.confidence).ok_or_else(|| {
             FitError::input("landmarks", "the hips and shoulders do not fix the body's orientation")
         })?;
-        let q = glam::Quat::from_mat3(&DMat3::as_mat3(&rotation)).normalize();
-        let global = quat_axis_angle(q);
+        let global = quat_axis_angle(q.as_quat());
         p[..3].copy_from_slice(&global.map(|v| v as f64));
         let hips_cam = hip_position(observed, camera)
             .ok_or_else(|| FitError::input("landmarks", "too few confident landmarks to place the body"))?;
@@ -354,12 +449,19 @@ impl Fitter {
     }
 }
 
-/// One frame's residuals: the fitter, what it sees, and an optional pull toward earlier
-/// parameters (with its weight).
+/// A pull toward earlier parameters, per radian and per metre (the orientation's by its
+/// geodesic), and toward an orientation.
+struct Pull<'a> {
+    params: &'a [f64],
+    weight: f64,
+    facing: Option<(DQuat, f64)>,
+}
+
+/// One frame's residuals: the fitter, what it sees, and an optional pull.
 struct Problem<'a> {
     fitter: &'a Fitter,
     observed: &'a Observed,
-    anchor: Option<(&'a [f64], f64)>,
+    anchor: Option<Pull<'a>>,
 }
 
 impl Problem<'_> {
@@ -405,9 +507,14 @@ impl Problem<'_> {
         }
         pose_prior::residuals(&p[3..Layout::POSE], relaxed, LIMIT_WEIGHT, rest, &mut r);
         r.extend(p[Layout::POSE..layout.transl()].iter().map(|b| SHAPE_WEIGHT * b));
-        if let Some((q, w)) = self.anchor {
-            let moving = (0..Layout::POSE).chain(layout.transl()..layout.len());
+        if let Some(Pull { params: q, weight: w, facing }) = &self.anchor {
+            let turned = orientation(p);
+            r.extend((*w * rotation_gap(orientation(q), turned)).to_array());
+            let moving = (3..Layout::POSE).chain(layout.transl()..layout.len());
             r.extend(moving.map(|i| w * (p[i] - q[i])));
+            if let Some((target, wf)) = facing {
+                r.extend((*wf * rotation_gap(*target, turned)).to_array());
+            }
         }
         r
     }

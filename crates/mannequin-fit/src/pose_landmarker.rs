@@ -5,6 +5,7 @@
 
 use mannequin_data::{Image, Mask};
 
+use crate::blazepose;
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
 use crate::network::Network;
@@ -47,6 +48,32 @@ impl PoseLandmarks {
     /// The person's mask as pixels: probability above one half.
     pub fn person_mask(&self, width: usize, height: usize) -> Mask {
         Mask { width, height, values: self.mask.iter().map(|&p| p > 0.5).collect() }
+    }
+
+    /// The other reading of the same picture: left and right swapped, depth turned over (about
+    /// the hips). Seen from the side or behind, a landmarker can return this mirror of the
+    /// person; both project to the same points.
+    pub fn mirrored(&self) -> Self {
+        let from = |i: usize| blazepose::mirror(i);
+        let n = self.points.len();
+        Self {
+            points: (0..n)
+                .map(|i| {
+                    let [x, y, z] = self.points[from(i)];
+                    [x, y, -z]
+                })
+                .collect(),
+            visibility: (0..n).map(|i| self.visibility[from(i)]).collect(),
+            presence: (0..n).map(|i| self.presence[from(i)]).collect(),
+            world: (0..n)
+                .map(|i| {
+                    let [x, y, z] = self.world[from(i)];
+                    [x, y, -z]
+                })
+                .collect(),
+            mask: self.mask.clone(),
+            ..*self
+        }
     }
 }
 

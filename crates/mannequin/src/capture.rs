@@ -9,15 +9,19 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use mannequin_body::BodyModel;
-use mannequin_data::layout::IMAGE_EXTENSIONS;
+use mannequin_data::layout::{self, IMAGE_EXTENSIONS};
+use mannequin_data::maps::read_mask_npy;
 use mannequin_data::splits::SplitRange;
 use mannequin_data::{Cameras, DatasetWriter, Frame, Image, Poses, Splits};
-use mannequin_fit::body_fit::Fitter;
-use mannequin_fit::capture::{Tracker, fit_clip, fit_clip_steps};
-use mannequin_fit::pose_landmarker::PoseLandmarks;
+use mannequin_fit::body_fit::{Fitter, FramePose};
+use mannequin_fit::capture::{ClipFit, ClipProgress, Tracker, resolve_mirrors};
+use mannequin_fit::crop::RotatedRect;
+use mannequin_fit::pose_landmarker::{NUM_LANDMARKS, PoseLandmarks};
 use mannequin_fit::{BodyFit, PersonModels};
+use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::body::load_body;
+use crate::checkpoint::{CHECKPOINT, add_run, check_run, file_hash};
 use crate::fit::{FitArgs, check_picture, posed_mesh};
 use crate::progress::{JobTimer, bar};
 
@@ -40,9 +44,26 @@ pub struct Args {
     max_frames: Option<usize>,
     #[command(flatten)]
     fitting: FitArgs,
-    /// The dataset folder to write.
+    /// The dataset folder to write. A capture that was stopped resumes from its checkpoint there.
     #[arg(long)]
     out: PathBuf,
+    /// Ignore a checkpoint in --out and start over.
+    #[arg(long)]
+    restart: bool,
+}
+
+/// Frames tracked between checkpoints.
+const CHECKPOINT_EVERY: usize = 10;
+
+/// What changes a capture's result: a checkpoint of other settings is refused.
+#[derive(serde::Serialize, serde::Deserialize, PartialEq)]
+struct CaptureRun {
+    /// Each source frame's file name and hash, or the video's.
+    source: Vec<String>,
+    fps: Option<f64>,
+    max_frames: Option<usize>,
+    body: String,
+    focal: Option<f64>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -61,26 +82,61 @@ pub fn run(args: Args) -> Result<()> {
     if files.len() < 2 {
         bail!("{}: {} frame(s); a capture needs at least 2", dir.display(), files.len());
     }
+    let run = CaptureRun {
+        source: match &args.video {
+            Some(video) => vec![format!("{} {}", video.display(), file_hash(video)?)],
+            None => frame_hashes(&files)?,
+        },
+        fps: args.fps,
+        max_frames: args.max_frames,
+        body: args.fitting.body.clone(),
+        focal: args.fitting.focal,
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let checkpoint = args.out.join(CHECKPOINT);
+    let mut saved = if !args.restart && checkpoint.exists() {
+        let saved = read_checkpoint(&checkpoint, &run, &args.out)?;
+        tracing::info!(
+            "resuming {} ({} of {} frames tracked, {} fit passes done)",
+            checkpoint.display(),
+            saved.tracked,
+            files.len(),
+            saved.fit.passes
+        );
+        saved
+    } else {
+        Saved::default()
+    };
     let model = load_body(&args.fitting.body)?;
     let models = PersonModels::load()?;
-    let (kept, people, skipped) = track(&models, &files)?;
-    let (width, height) = (kept[0].1.width, kept[0].1.height);
+    track(&models, &files, &args.out, &checkpoint, &run, &mut saved)?;
+    let (width, height) = (saved.kept[0].1.width, saved.kept[0].1.height);
     let focal = args.fitting.focal(width, height);
     let fitter = Fitter::new(&model, width, height, focal)?;
-    let progress = bar(fit_clip_steps(people.len()) as u64, "body fit");
-    let fits = fit_clip(&fitter, &people, &mut || progress.inc(1))?;
+    // The fit reads the landmarks with the mirrors undone; the checkpoint keeps them as read.
+    let mut people_read = saved.people.clone();
+    let mirrored = resolve_mirrors(&fitter, &mut people_read);
+    let mut clip = ClipFit::new(&fitter, &people_read, std::mem::take(&mut saved.fit))?;
+    let progress = bar(ClipFit::steps(people_read.len()) as u64, "body fit");
+    while clip.next_pass(&mut || progress.inc(1))? {
+        saved.fit = clip.progress.clone();
+        write_checkpoint(&checkpoint, &run, &saved)?;
+    }
     progress.finish();
-    write_dataset(&args.out, &kept, &people, &fits)?;
-    let ious = write_overlays(&args.out, &model, &kept, &people, &fits)?;
+    let fits = clip.fits()?;
+    let Saved { kept, skipped, .. } = &saved;
+    write_dataset(&args.out, &fits)?;
+    let ious = write_overlays(&args.out, &model, kept, &people_read, &fits)?;
     if decoded.is_some() {
         std::fs::remove_dir_all(dir).with_context(|| format!("removing {}", dir.display()))?;
     }
-    let report = report(&kept, &fits, &ious, &skipped, focal, start.elapsed().as_secs_f64());
+    let report = report(kept, &fits, &ious, skipped, &mirrored, focal, start.elapsed().as_secs_f64());
     mannequin_io::write_atomic(
         &args.out.join("capture.json"),
         serde_json::to_string_pretty(&report)?.as_bytes(),
     )
     .with_context(|| format!("writing {}", args.out.join("capture.json").display()))?;
+    std::fs::remove_file(&checkpoint).with_context(|| format!("removing {}", checkpoint.display()))?;
     tracing::info!(
         "captured {} frames ({} without the person left out) into {}",
         kept.len(),
@@ -88,6 +144,23 @@ pub fn run(args: Args) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Each frame file's name and hash: a checkpoint is only resumed on the same frames.
+fn frame_hashes(files: &[PathBuf]) -> Result<Vec<String>> {
+    files.iter().map(|f| Ok(format!("{} {}", f.display(), file_hash(f)?))).collect()
+}
+
+/// What a capture has done so far: frames tracked (the kept ones written to the dataset as they
+/// come), and the fit's passes.
+#[derive(Default)]
+struct Saved {
+    /// Source frames looked at, kept or not.
+    tracked: usize,
+    kept: Vec<(PathBuf, Image)>,
+    people: Vec<PoseLandmarks>,
+    skipped: Vec<PathBuf>,
+    fit: ClipProgress,
 }
 
 /// Decodes `video` into PNG frames under `out/.frames` with ffmpeg.
@@ -132,19 +205,32 @@ fn frame_files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// Each frame's image and the person's landmarks; frames where nobody is found are left out and
-/// named.
-#[allow(clippy::type_complexity)]
+/// Each frame's image and the person's landmarks, from where `saved` left off; frames where nobody
+/// is found are left out and named. Each kept frame's image and mask go into the dataset as it
+/// comes, and a checkpoint every few frames.
 fn track(
     models: &PersonModels,
     files: &[PathBuf],
-) -> Result<(Vec<(PathBuf, Image)>, Vec<PoseLandmarks>, Vec<PathBuf>)> {
+    out: &Path,
+    checkpoint: &Path,
+    run: &CaptureRun,
+    saved: &mut Saved,
+) -> Result<()> {
+    let writer = DatasetWriter::new(out);
+    for sub in ["images", "masks", "poses"] {
+        std::fs::create_dir_all(out.join(sub))
+            .with_context(|| format!("creating {}", out.join(sub).display()))?;
+    }
     let progress = bar(files.len() as u64, "landmarks");
-    let mut tracker = Tracker::new(models);
-    let (mut kept, mut people, mut skipped) = (Vec::<(PathBuf, Image)>::new(), Vec::new(), Vec::new());
-    for file in files {
+    progress.set_position(saved.tracked as u64);
+    let last_kept = saved.kept.last().map(|(f, _)| f);
+    let followed = (saved.tracked > 0 && last_kept == Some(&files[saved.tracked - 1]))
+        .then(|| saved.people.last().map(|l| l.next_roi))
+        .flatten();
+    let mut tracker = Tracker::resume(models, followed);
+    for (i, file) in files.iter().enumerate().skip(saved.tracked) {
         let image = Image::read(file)?;
-        if let Some((_, first)) = kept.first()
+        if let Some((_, first)) = saved.kept.first()
             && (image.width, image.height) != (first.width, first.height)
         {
             bail!(
@@ -158,38 +244,148 @@ fn track(
         }
         match tracker.next(&image).with_context(|| file.display().to_string())? {
             Some(l) => {
-                people.push(l);
-                kept.push((file.clone(), image));
+                let mask = l.person_mask(image.width, image.height);
+                let frame = Frame { index: saved.kept.len(), image, mask, normals: None, depth: None };
+                writer.write_frame(&frame)?;
+                saved.people.push(l);
+                saved.kept.push((file.clone(), frame.image));
             }
-            None => skipped.push(file.clone()),
+            None => saved.skipped.push(file.clone()),
+        }
+        saved.tracked = i + 1;
+        if saved.tracked.is_multiple_of(CHECKPOINT_EVERY) && saved.tracked < files.len() {
+            write_checkpoint(checkpoint, run, saved)?;
         }
         progress.inc(1);
     }
     progress.finish();
-    if kept.len() < 2 {
-        bail!("the person was found in {} of {} frames; a capture needs at least 2", kept.len(), files.len());
+    if saved.kept.len() < 2 {
+        bail!(
+            "the person was found in {} of {} frames; a capture needs at least 2",
+            saved.kept.len(),
+            files.len()
+        );
     }
-    Ok((kept, people, skipped))
+    write_checkpoint(checkpoint, run, saved)
 }
 
-fn write_dataset(
-    out: &Path,
-    kept: &[(PathBuf, Image)],
-    people: &[PoseLandmarks],
-    fits: &[BodyFit],
-) -> Result<()> {
+/// Stores what `saved` holds but the dataset already has (each kept frame's image and mask).
+fn write_checkpoint(path: &Path, run: &CaptureRun, saved: &Saved) -> Result<()> {
+    let mut w = NpzWriter::new();
+    add_run(&mut w, run)?;
+    let k = saved.people.len();
+    let names = |files: &mut dyn Iterator<Item = &PathBuf>| -> Result<String> {
+        Ok(serde_json::to_string(&files.map(|f| f.display().to_string()).collect::<Vec<_>>())?)
+    };
+    w.add("tracked", NpyArray::i64(vec![1], vec![saved.tracked as i64]));
+    w.add("kept", NpyArray::text(&names(&mut saved.kept.iter().map(|(f, _)| f))?));
+    w.add("skipped", NpyArray::text(&names(&mut saved.skipped.iter())?));
+    let per_landmark = |f: &dyn Fn(&PoseLandmarks) -> Vec<f32>, width: usize| {
+        NpyArray::f32(vec![k, NUM_LANDMARKS, width], saved.people.iter().flat_map(f).collect())
+    };
+    w.add("points", per_landmark(&|l| l.points.iter().flatten().copied().collect(), 3));
+    w.add("world", per_landmark(&|l| l.world.iter().flatten().copied().collect(), 3));
+    w.add("visibility", per_landmark(&|l| l.visibility.clone(), 1));
+    w.add("presence", per_landmark(&|l| l.presence.clone(), 1));
+    let rect = |r: &RotatedRect| [r.cx, r.cy, r.width, r.height, r.rotation];
+    w.add("roi", NpyArray::f32(vec![k, 5], saved.people.iter().flat_map(|l| rect(&l.roi)).collect()));
+    w.add(
+        "next_roi",
+        NpyArray::f32(vec![k, 5], saved.people.iter().flat_map(|l| rect(&l.next_roi)).collect()),
+    );
+    w.add("flag", NpyArray::f32(vec![k], saved.people.iter().map(|l| l.flag).collect()));
+    let fit = &saved.fit;
+    w.add("passes", NpyArray::i64(vec![1], vec![fit.passes as i64]));
+    w.add("betas", NpyArray::f32(vec![fit.betas.len()], fit.betas.clone()));
+    let poses = fit.frames.iter().flat_map(|f| f.pose.iter().copied()).collect();
+    w.add("poses", NpyArray::f32(vec![fit.frames.len(), 72], poses));
+    w.add(
+        "transl",
+        NpyArray::f32(vec![fit.frames.len(), 3], fit.frames.iter().flat_map(|f| f.transl).collect()),
+    );
+    w.write(path)?;
+    Ok(())
+}
+
+/// What [`write_checkpoint`] stored, with the kept frames' images and masks read back from the
+/// dataset; refused when it is another run's.
+fn read_checkpoint(path: &Path, run: &CaptureRun, out: &Path) -> Result<Saved> {
+    let npz = Npz::read(path)?;
+    check_run(&npz, path, run)?;
+    let count = |key: &str| -> Result<usize> {
+        let v = npz.require(key)?.to_i64().and_then(|n| n.first().copied()).unwrap_or(-1);
+        Ok(usize::try_from(v).map_err(|_| npz.field_error(key, "a count"))?)
+    };
+    let names = |key: &str| -> Result<Vec<PathBuf>> {
+        let names: Vec<String> = serde_json::from_str(npz.text(key)?)
+            .with_context(|| format!("{}: {key}: expected a JSON list of file names", path.display()))?;
+        Ok(names.into_iter().map(PathBuf::from).collect())
+    };
+    let kept_files = names("kept")?;
+    let k = kept_files.len();
+    let read = |key: &str, shape: &[Option<usize>]| -> Result<Vec<f32>> {
+        Ok(npz.f64_with_shape(key, shape)?.1.into_iter().map(|v| v as f32).collect())
+    };
+    let (n, k3) = (Some(NUM_LANDMARKS), Some(k));
+    let points = read("points", &[k3, n, Some(3)])?;
+    let world = read("world", &[k3, n, Some(3)])?;
+    let visibility = read("visibility", &[k3, n, Some(1)])?;
+    let presence = read("presence", &[k3, n, Some(1)])?;
+    let roi = read("roi", &[k3, Some(5)])?;
+    let next_roi = read("next_roi", &[k3, Some(5)])?;
+    let flag = read("flag", &[k3])?;
+    let rect = |r: &[f32]| RotatedRect { cx: r[0], cy: r[1], width: r[2], height: r[3], rotation: r[4] };
+    let mut kept = Vec::with_capacity(k);
+    let mut people = Vec::with_capacity(k);
+    for (i, file) in kept_files.into_iter().enumerate() {
+        let image = Image::read(&layout::image(out, i))?;
+        let mask = read_mask_npy(&layout::mask(out, i))?;
+        let triples = |v: &[f32]| {
+            v[i * 3 * NUM_LANDMARKS..(i + 1) * 3 * NUM_LANDMARKS]
+                .chunks_exact(3)
+                .map(|p| [p[0], p[1], p[2]])
+                .collect()
+        };
+        let singles = |v: &[f32]| v[i * NUM_LANDMARKS..(i + 1) * NUM_LANDMARKS].to_vec();
+        people.push(PoseLandmarks {
+            roi: rect(&roi[5 * i..5 * i + 5]),
+            flag: flag[i],
+            points: triples(&points),
+            visibility: singles(&visibility),
+            presence: singles(&presence),
+            world: triples(&world),
+            next_roi: rect(&next_roi[5 * i..5 * i + 5]),
+            // The mask as the fit reads it: the person where the probability passed one half.
+            mask: mask.values.iter().map(|&b| if b { 1.0 } else { 0.0 }).collect(),
+        });
+        kept.push((file, image));
+    }
+    let passes = count("passes")?;
+    let betas = read("betas", &[None])?;
+    let frames = if passes > 0 {
+        let poses = read("poses", &[k3, Some(72)])?;
+        let transl = read("transl", &[k3, Some(3)])?;
+        (0..k)
+            .map(|i| FramePose {
+                pose: poses[72 * i..72 * i + 72].to_vec(),
+                transl: [transl[3 * i], transl[3 * i + 1], transl[3 * i + 2]],
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    Ok(Saved {
+        tracked: count("tracked")?,
+        kept,
+        people,
+        skipped: names("skipped")?,
+        fit: ClipProgress { passes, betas, frames },
+    })
+}
+
+/// The dataset's camera, poses and splits (its frames are written as they are tracked).
+fn write_dataset(out: &Path, fits: &[BodyFit]) -> Result<()> {
     let writer = DatasetWriter::new(out);
-    for sub in ["images", "masks", "poses"] {
-        std::fs::create_dir_all(out.join(sub))
-            .with_context(|| format!("creating {}", out.join(sub).display()))?;
-    }
-    let progress = bar(kept.len() as u64, "writing");
-    for (index, ((_, image), person)) in kept.iter().zip(people).enumerate() {
-        let mask = person.person_mask(image.width, image.height);
-        writer.write_frame(&Frame { index, image: image.clone(), mask, normals: None, depth: None })?;
-        progress.inc(1);
-    }
-    progress.finish();
     writer.write_cameras(&Cameras::Static(fits[0].camera.clone()))?;
     let all = Poses {
         betas: fits[0].betas.clone(),
@@ -238,6 +434,7 @@ fn report(
     fits: &[BodyFit],
     ious: &[f64],
     skipped: &[PathBuf],
+    mirrored: &[usize],
     focal: f64,
     seconds: f64,
 ) -> serde_json::Value {
@@ -249,6 +446,7 @@ fn report(
         })).collect::<Vec<_>>(),
         "mean_mask_iou": ious.iter().sum::<f64>() / ious.len() as f64,
         "left_out": skipped.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+        "read_mirrored": mirrored.iter().map(|&i| kept[i].0.display().to_string()).collect::<Vec<_>>(),
         "betas": fits[0].betas,
         "focal_px": focal,
         "seconds": seconds,

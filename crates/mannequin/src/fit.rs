@@ -45,7 +45,7 @@ pub struct FitArgs {
     pub body: String,
     /// Focal length in pixels; by default the picture's long side (a 53° view across it).
     #[arg(long)]
-    focal: Option<f64>,
+    pub focal: Option<f64>,
 }
 
 impl FitArgs {

@@ -28,12 +28,7 @@ fn window(image: &Image, x0: usize) -> Image {
 #[test]
 fn a_sliding_clip_becomes_a_dataset_whose_body_slides_with_the_person() {
     let dir = scratch("capture_slide");
-    let frames = dir.join("frames");
-    std::fs::create_dir_all(&frames).unwrap();
-    let photo = camera_png();
-    for k in 0..5 {
-        window(&photo, STEP * k).write_png(&frames.join(format!("f{k}.png"))).unwrap();
-    }
+    let frames = sliding_frames(&dir);
     let out = dir.join("dataset");
     ok(mannequin(&["capture", "--frames", s(&frames), "--out", s(&out)]));
     let data = Dataset::open(&out, 1).unwrap();
@@ -79,6 +74,56 @@ fn a_sliding_clip_becomes_a_dataset_whose_body_slides_with_the_person() {
     assert!(share > 0.2 && share < 0.8, "the mask covers {share:.2} of the frame");
 }
 
+fn sliding_frames(dir: &Path) -> std::path::PathBuf {
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let photo = camera_png();
+    for k in 0..5 {
+        window(&photo, STEP * k).write_png(&frames.join(format!("f{k}.png"))).unwrap();
+    }
+    frames
+}
+
+/// A capture killed once its first checkpoint is written resumes from it and ends with what an
+/// uninterrupted capture writes; a checkpoint of other settings is refused, naming them.
+#[test]
+fn a_killed_capture_resumes_to_the_same_dataset() {
+    let dir = scratch("capture_resume");
+    let frames = sliding_frames(&dir);
+    let whole = dir.join("whole");
+    ok(mannequin(&["capture", "--frames", s(&frames), "--out", s(&whole)]));
+    let cut = dir.join("cut");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"))
+        .args(["capture", "--frames", s(&frames), "--out", s(&cut)])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let checkpoint = cut.join("checkpoint.npz");
+    while !checkpoint.exists() {
+        assert!(child.try_wait().unwrap().is_none(), "the capture ended before writing a checkpoint");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!cut.join("capture.json").exists(), "the capture finished before it was killed");
+    one_line_error(
+        &mannequin(&["capture", "--frames", s(&frames), "--out", s(&cut), "--focal", "500"]),
+        &["checkpoint.npz", "another run", "focal", "--restart"],
+    );
+    let resumed = ok(mannequin(&["capture", "--frames", s(&frames), "--out", s(&cut)]));
+    assert!(String::from_utf8_lossy(&resumed.stderr).contains("resuming"));
+    assert!(!checkpoint.exists(), "a finished capture leaves no checkpoint");
+    for file in
+        ["poses/anim_nerf_train.npz", "poses/anim_nerf_test.npz", "cameras.npz", "masks/mask_0003.npy"]
+    {
+        assert_eq!(
+            std::fs::read(whole.join(file)).unwrap(),
+            std::fs::read(cut.join(file)).unwrap(),
+            "{file}"
+        );
+    }
+}
+
 #[test]
 fn clips_that_cannot_make_a_dataset_are_refused_in_one_line() {
     let dir = scratch("capture_refusals");
@@ -90,6 +135,7 @@ fn clips_that_cannot_make_a_dataset_are_refused_in_one_line() {
         &mannequin(&["capture", "--frames", s(&frames), "--out", s(&out)]),
         &["1 frame(s)", "at least 2"],
     );
+    assert!(!out.exists(), "a refused capture writes nothing");
     one_line_error(
         &mannequin(&["capture", "--video", s(&dir.join("missing.mp4")), "--out", s(&out)]),
         &["missing.mp4", "no such video file"],
