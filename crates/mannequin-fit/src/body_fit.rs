@@ -9,7 +9,8 @@
 //! - a silhouette term: the distance from each of a few hundred body vertices, projected, to the
 //!   person's mask (`distance_transform.rs`). It only pulls the body inside the mask, never out
 //!   to fill it: clothes widen a silhouette, the body under them does not;
-//! - the pose prior of `pose_prior.rs` in place of the adversarial term, and a shape prior.
+//! - the pose prior of `pose_prior.rs` in place of the adversarial term, a shape prior, and
+//!   limbs kept out of each other (`interpenetration.rs`).
 //!
 //! The camera is OpenCV's, at the world origin, turned half a turn about x so the world is
 //! Y-up in front of it; the focal length is given or assumed. The body starts from the prior's
@@ -31,6 +32,7 @@ use crate::blazepose::{
 };
 use crate::distance_transform::distance_to;
 use crate::error::FitError;
+use crate::interpenetration;
 use crate::landmark_body::{LandmarkBody, PosedLandmarks};
 use crate::levenberg_marquardt::{Summary, minimise};
 use crate::pose_landmarker::{NUM_LANDMARKS, PoseLandmarks};
@@ -50,6 +52,9 @@ const WORLD_WEIGHT: f64 = 0.5;
 const LIMIT_WEIGHT: f64 = 30.0;
 const REST_WEIGHT: f64 = 0.6;
 const SHAPE_WEIGHT: f64 = 1.0;
+/// Per metre that two limbs overlap (a centimetre weighs about as much as a landmark off by 1 %
+/// of the crop).
+const PENETRATION_WEIGHT: f64 = 100.0;
 /// The silhouette term's weight as a whole (each sampled vertex carries 1/√n of it).
 const SILHOUETTE_WEIGHT: f64 = 3.0;
 /// About this many vertices, evenly spread over the mesh's indices, are held inside the mask.
@@ -506,6 +511,7 @@ impl Problem<'_> {
             r.push(w * observed.outside_at(u, v));
         }
         pose_prior::residuals(&p[3..Layout::POSE], relaxed, LIMIT_WEIGHT, rest, &mut r);
+        interpenetration::residuals(&posed.joints, PENETRATION_WEIGHT, &mut r);
         r.extend(p[Layout::POSE..layout.transl()].iter().map(|b| SHAPE_WEIGHT * b));
         if let Some(Pull { params: q, weight: w, facing }) = &self.anchor {
             let turned = orientation(p);

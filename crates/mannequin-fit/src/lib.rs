@@ -7,6 +7,7 @@ pub mod capture;
 pub mod crop;
 pub mod distance_transform;
 pub mod error;
+pub mod interpenetration;
 pub mod landmark_body;
 pub mod levenberg_marquardt;
 pub mod network;

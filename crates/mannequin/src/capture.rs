@@ -8,11 +8,13 @@ use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use glam::{DMat3, DMat4, DVec3};
 use mannequin_body::BodyModel;
+use mannequin_body::rodrigues::axis_angle_quat;
 use mannequin_data::layout::{self, IMAGE_EXTENSIONS};
 use mannequin_data::maps::read_mask_npy;
 use mannequin_data::splits::SplitRange;
-use mannequin_data::{Cameras, DatasetWriter, Frame, Image, Poses, Splits};
+use mannequin_data::{Camera, Cameras, DatasetWriter, Frame, Image, Poses, Splits};
 use mannequin_fit::body_fit::{Fitter, FramePose};
 use mannequin_fit::capture::{ClipFit, ClipProgress, Tracker, resolve_mirrors};
 use mannequin_fit::crop::RotatedRect;
@@ -47,6 +49,11 @@ pub struct Args {
     /// The dataset folder to write. A capture that was stopped resumes from its checkpoint there.
     #[arg(long)]
     out: PathBuf,
+    /// The person stands still and the camera moves: write the body held where the first frame
+    /// has it and a camera per frame (the same fit, seen the other way) instead of one static
+    /// camera and the body turning in front of it.
+    #[arg(long)]
+    moving_camera: bool,
     /// Ignore a checkpoint in --out and start over.
     #[arg(long)]
     restart: bool,
@@ -125,7 +132,7 @@ pub fn run(args: Args) -> Result<()> {
     progress.finish();
     let fits = clip.fits()?;
     let Saved { kept, skipped, .. } = &saved;
-    write_dataset(&args.out, &fits)?;
+    write_dataset(&args.out, &model, &fits, args.moving_camera)?;
     let ious = write_overlays(&args.out, &model, kept, &people_read, &fits)?;
     if decoded.is_some() {
         std::fs::remove_dir_all(dir).with_context(|| format!("removing {}", dir.display()))?;
@@ -383,16 +390,24 @@ fn read_checkpoint(path: &Path, run: &CaptureRun, out: &Path) -> Result<Saved> {
     })
 }
 
-/// The dataset's camera, poses and splits (its frames are written as they are tracked).
-fn write_dataset(out: &Path, fits: &[BodyFit]) -> Result<()> {
+/// The dataset's cameras, poses and splits (its frames are written as they are tracked): one
+/// static camera, or with `moving_camera` the body held still and a camera per frame.
+fn write_dataset(out: &Path, model: &BodyModel, fits: &[BodyFit], moving_camera: bool) -> Result<()> {
     let writer = DatasetWriter::new(out);
-    writer.write_cameras(&Cameras::Static(fits[0].camera.clone()))?;
-    let all = Poses {
+    let mut all = Poses {
         betas: fits[0].betas.clone(),
         global_orient: fits.iter().map(|f| [f.pose[0], f.pose[1], f.pose[2]]).collect(),
         body_pose: fits.iter().flat_map(|f| f.pose[3..].iter().copied()).collect(),
         transl: fits.iter().map(|f| f.transl).collect(),
     };
+    if moving_camera {
+        writer.write_cameras(&Cameras::PerFrame(moving_cameras(model, fits)?))?;
+        let (orient, transl) = (all.global_orient[0], all.transl[0]);
+        all.global_orient.fill(orient);
+        all.transl.fill(transl);
+    } else {
+        writer.write_cameras(&Cameras::Static(fits[0].camera.clone()))?;
+    }
     let n = fits.len();
     let test = (n / TEST_SHARE).max(1);
     let mut splits = Splits::new();
@@ -404,6 +419,28 @@ fn write_dataset(out: &Path, fits: &[BodyFit]) -> Result<()> {
     }
     writer.write_splits(&splits)?;
     Ok(())
+}
+
+/// The clip seen the other way, for a person standing still while the camera moves: the body
+/// held where frame 0 has it, and a camera per frame. Frame i's body is its root-relative pose
+/// moved by Mᵢ (its orientation about the rest root joint, then its translation), so the camera
+/// E·Mᵢ·M₀⁻¹ sees frame 0's placement exactly as E sees frame i's.
+fn moving_cameras(model: &BodyModel, fits: &[BodyFit]) -> Result<Vec<Camera>> {
+    let rest = mannequin_body::forward(model, &fits[0].betas, &[0.0; 72], &[0.0; 3])?;
+    let root = DVec3::new(rest.joints[0] as f64, rest.joints[1] as f64, rest.joints[2] as f64);
+    let placement = |f: &BodyFit| {
+        let turn = DMat3::from_quat(axis_angle_quat([f.pose[0], f.pose[1], f.pose[2]]).as_dquat());
+        let t = DVec3::new(f.transl[0] as f64, f.transl[1] as f64, f.transl[2] as f64);
+        DMat4::from_mat3_translation(turn, root + t - turn * root)
+    };
+    let first = placement(&fits[0]).inverse();
+    Ok(fits
+        .iter()
+        .map(|f| {
+            let seen = DMat4::from_cols_array_2d(&f.camera.extrinsic).transpose() * placement(f) * first;
+            Camera { extrinsic: seen.transpose().to_cols_array_2d(), ..f.camera.clone() }
+        })
+        .collect())
 }
 
 /// `overlay/frame_%04d.png` for checking each frame's fit; the IoU of each body silhouette with

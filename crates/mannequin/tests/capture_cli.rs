@@ -67,6 +67,25 @@ fn a_sliding_clip_becomes_a_dataset_whose_body_slides_with_the_person() {
     // The coat widens the mask beyond the body (the photo alone gives 0.64).
     let iou = report["mean_mask_iou"].as_f64().unwrap();
     assert!(iou > 0.5, "mean mask IoU {iou}");
+    // The same clip as a still person and a moving camera: every frame's body must land where
+    // the static camera saw it.
+    let still = dir.join("still");
+    ok(mannequin(&["capture", "--frames", s(&frames), "--out", s(&still), "--moving-camera"]));
+    let moved = Dataset::open(&still, 1).unwrap();
+    let (a, b) = (moved.split("train").unwrap().poses, moved.split("test").unwrap().poses);
+    for i in 0..5 {
+        let (pose, transl) = if i < 4 { (a.pose72(i), a.transl[i]) } else { (b.pose72(0), b.transl[0]) };
+        assert_eq!((&pose[..3], transl), (&a.pose72(0)[..3], a.transl[0]), "the body holds still");
+        let seen = mannequin_body::forward(&model, &a.betas, &pose, &transl).unwrap();
+        let want = mannequin_body::forward(&model, &poses.betas, &poses.pose72(i), &poses.transl[i]).unwrap();
+        for (p, q) in seen.vertices.chunks_exact(3).zip(want.vertices.chunks_exact(3)).step_by(97) {
+            let uv = |c: &mannequin_data::Camera, p: &[f32]| {
+                c.project(c.world_to_camera(glam::Vec3::from_slice(p).as_dvec3()))
+            };
+            let (x, y) = (uv(moved.camera(i), p), uv(camera, q));
+            assert!((x[0] - y[0]).hypot(x[1] - y[1]) < 0.05, "frame {i}: {x:?} against {y:?}");
+        }
+    }
     let overlay = Image::read(&out.join("overlay/frame_0004.png")).unwrap();
     assert_eq!((overlay.width, overlay.height), (SIDE, SIDE));
     let frame = data.frame(2).unwrap();
