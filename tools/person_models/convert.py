@@ -18,6 +18,10 @@ TFLite files (no DEQUANTIZE, DENSIFY, RESIZE_BILINEAR, ...), but runs their ONNX
 - `selfie_segmentation.onnx` (input [1,256,256,3] in [0,1]; `mask` [1,256,256,1], a probability):
   tf2onnx leaves MediaPipe's custom op `Convolution2DTransposeBias`, replaced here by ConvTranspose
   (kernel 2, stride 2, bias).
+- `face_detection_short_range.onnx` (BlazeFace; input [1,128,128,3] in [-1,1]; `regressors`
+  [1,896,16] = box and 6 keypoints, `scores` [1,896,1] logits) and `face_landmark.onnx` (input
+  [1,192,192,3] in [0,1]; `landmarks` [1,1,1,1404] = 468 face-mesh points x, y, z in crop pixels,
+  `face_flag` [1,1,1,1] logit): tf2onnx as they are.
 
 All take NHWC float32 named `input`, fixed shapes, opset 17, float32 weights. Each is checked
 (onnx checker, strict shape inference, onnxruntime against the original on the fixture pictures)
@@ -26,9 +30,11 @@ and `LICENSE` (the wheel's) and `NOTICE.md` (sources, sha256, changes) are writt
 `fixtures DIR` writes, for scikit-image's `astronaut` and `camera` (grey, channels repeated):
 `landmark_<image>.npz`, `selfie_<image>.npz` (the picture resized to 256² with Pillow's
 bilinear `Image.resize`, `input_u8` [256,256,3], fed as input_u8 / 255), `detection_<image>.npz`
-(224², fed as input_u8 / 127.5 - 1) holding each original output under the ONNX names (heatmaps
-left out: 640 kB of noise), and `pipeline_<image>.npz`, MediaPipe's whole pose pipeline on the
-512² picture, the end-to-end oracle for the Rust detection -> crop -> landmark path.
+(224², fed as input_u8 / 127.5 - 1), `face_detection_<image>.npz` (128², as the pose detector)
+and `face_landmark_<image>.npz` (192², / 255) holding each original output under the ONNX names
+(heatmaps left out: 640 kB of noise); `pipeline_<image>.npz`, MediaPipe's whole pose pipeline on
+the 512² picture, the end-to-end oracle for the Rust detection -> crop -> landmark path; and
+`face_pipeline_<image>.npz`, its face-mesh pipeline likewise.
 
 The original runs: pose detection and landmarks in ai-edge-litert's interpreter without its
 default XNNPACK delegate (which swallows the fp16 DEQUANTIZE outputs: every weight reads zero);
@@ -60,11 +66,23 @@ MODULES = os.path.join(mp.__path__[0], "modules")
 DETECTION = "pose_detection/pose_detection.tflite"
 LANDMARK = "pose_landmark/pose_landmark_full.tflite"
 SELFIE = "selfie_segmentation/selfie_segmentation.tflite"
+FACE_DETECTION = "face_detection/face_detection_short_range.tflite"
+FACE_LANDMARK = "face_landmark/face_landmark.tflite"
 # TFLite output order -> ONNX output names.
 OUTPUT_NAMES = {
     DETECTION: ["regressors", "scores"],
     LANDMARK: ["landmarks", "pose_flag", "mask", "heatmaps", "world_landmarks"],
     SELFIE: ["mask"],
+    FACE_DETECTION: ["regressors", "scores"],
+    FACE_LANDMARK: ["landmarks", "face_flag"],
+}
+# Each model's input side and value range: (side, divisor, offset), fed pixel_u8 / divisor + offset.
+INPUTS = {
+    DETECTION: (224, 127.5, -1.0),
+    LANDMARK: (256, 255, 0.0),
+    SELFIE: (256, 255, 0.0),
+    FACE_DETECTION: (128, 127.5, -1.0),
+    FACE_LANDMARK: (192, 255, 0.0),
 }
 IMAGES = ["astronaut", "camera"]
 OPSET = 17
@@ -305,6 +323,8 @@ def write_models(out_dir):
         (SELFIE, "converted by tf2onnx; MediaPipe's custom op Convolution2DTransposeBias replaced "
                  "by ConvTranspose (kernel 2, stride 2, weights [out,kh,kw,in] -> [in,out,kh,kw], "
                  "bias) followed by an NCHW -> NHWC Transpose"),
+        (FACE_DETECTION, "converted by tf2onnx (fp16 weights DEQUANTIZEd to float32 constants)"),
+        (FACE_LANDMARK, "converted by tf2onnx (fp16 weights DEQUANTIZEd to float32 constants)"),
     ]:
         name = os.path.basename(model).replace(".tflite", ".onnx")
         digest = sha256(tflite_path(model))
@@ -414,21 +434,21 @@ def resized(image, size):
 
 
 def model_input(model, image):
-    if model == DETECTION:
-        return (resized(image, 224).astype(np.float32) / 127.5 - 1)[None]
-    return (resized(image, 256).astype(np.float32) / 255)[None]
+    side, divisor, offset = INPUTS[model]
+    return (resized(image, side).astype(np.float32) / divisor + offset)[None]
 
 
 def write_fixtures(out_dir):
     os.makedirs(out_dir, exist_ok=True)
     for image in IMAGES:
-        for prefix, model, size in [("detection", DETECTION, 224), ("landmark", LANDMARK, 256),
-                                    ("selfie", SELFIE, 256)]:
+        for prefix, model in [("detection", DETECTION), ("landmark", LANDMARK), ("selfie", SELFIE),
+                              ("face_detection", FACE_DETECTION), ("face_landmark", FACE_LANDMARK)]:
             outputs = run_tflite(model, model_input(model, image))
             outputs.pop("heatmaps", None)
-            save(out_dir, f"{prefix}_{image}.npz", input_u8=resized(image, size),
+            save(out_dir, f"{prefix}_{image}.npz", input_u8=resized(image, INPUTS[model][0]),
                  **{k: v.astype(np.float32) for k, v in outputs.items()})
         save(out_dir, f"pipeline_{image}.npz", **pipeline(picture(image)))
+        save(out_dir, f"face_pipeline_{image}.npz", **face_pipeline(picture(image)))
         shutil.copyfile(picture_path(image), os.path.join(out_dir, f"{image}.png"))
     write_provenance(out_dir)
 
@@ -489,6 +509,17 @@ def write_provenance(out_dir):
         "radians). Replayed with the ONNX models here, it matched to 0.33 px only with a 9x9 "
         "heatmap refinement window: MediaPipe 0.10.21 behaves as RefineLandmarksFromHeatmap's "
         "default kernel_size 9, though its graph sets 7.",
+        "- `face_detection_<image>.npz`: `input_u8` [128,128,3]; fed input_u8 / 127.5 - 1; "
+        "`regressors` [1,896,16], `scores` [1,896,1] (logits).",
+        "- `face_landmark_<image>.npz`: `input_u8` [192,192,3] (the whole picture, not a face "
+        "crop: a check of the network, not of the crop); fed input_u8 / 255; `landmarks` "
+        "[1,1,1,1404] (crop pixels), `face_flag` [1,1,1,1] (a logit).",
+        "- `face_pipeline_<image>.npz`: MediaPipe's legacy `FaceMesh(static_image_mode=True, "
+        "max_num_faces=1, refine_landmarks=False)` graph on the 512² RGB picture: `found` [1], "
+        "`landmarks_norm` [468,3] (x, y in [0,1] of the image, z on x's scale), `landmarks_px` "
+        "(x, z times the width, y times the height), `detection` [17] (score, xmin, ymin, width, "
+        "height, then 6 keypoints x, y, relative to the image), `roi` [5] (the mesh crop made "
+        "from that detection: x_center, y_center, width, height relative, rotation in radians).",
         "",
     ]
     with open(os.path.join(out_dir, "PROVENANCE.md"), "w") as f:
@@ -537,6 +568,38 @@ def pipeline(rgb):
         [d.score[0], box.xmin, box.ymin, box.width, box.height] +
         [v for k in d.location_data.relative_keypoints for v in (k.x, k.y)], np.float32)
     roi = r.pose_rect_from_detection
+    out["roi"] = np.array([roi.x_center, roi.y_center, roi.width, roi.height, roi.rotation], np.float32)
+    return out
+
+
+def face_pipeline(rgb):
+    """mp.solutions.face_mesh.FaceMesh(static_image_mode=True, max_num_faces=1,
+    refine_landmarks=False), through its SolutionBase with the same graph, side inputs and
+    parameters, asking for the face detection and the crop it made too."""
+    from mediapipe.python.solution_base import SolutionBase
+    from mediapipe.python.solutions import face_mesh
+    solution = SolutionBase(
+        binary_graph_path=face_mesh._BINARYPB_FILE_PATH,
+        side_inputs={"num_faces": 1, "with_attention": False, "use_prev_landmarks": False},
+        calculator_params={
+            "facedetectionshortrangecpu__facedetectionshortrange__facedetection__TensorsToDetectionsCalculator.min_score_thresh": 0.5,
+            "facelandmarkcpu__ThresholdingCalculator.threshold": 0.5},
+        outputs=["multi_face_landmarks", "face_detections", "face_rects_from_detections"])
+    with solution:
+        r = solution.process({"image": rgb})
+    h, w = rgb.shape[:2]
+    out = {"found": np.array([float(bool(r.multi_face_landmarks))], np.float32)}
+    if not r.multi_face_landmarks:
+        return out
+    lm = r.multi_face_landmarks[0].landmark
+    out["landmarks_norm"] = np.array([[p.x, p.y, p.z] for p in lm], np.float32)
+    out["landmarks_px"] = out["landmarks_norm"] * np.array([w, h, w], np.float32)
+    d = r.face_detections[0]
+    box = d.location_data.relative_bounding_box
+    out["detection"] = np.array(
+        [d.score[0], box.xmin, box.ymin, box.width, box.height] +
+        [v for k in d.location_data.relative_keypoints for v in (k.x, k.y)], np.float32)
+    roi = r.face_rects_from_detections[0]
     out["roi"] = np.array([roi.x_center, roi.y_center, roi.width, roi.height, roi.rotation], np.float32)
     return out
 

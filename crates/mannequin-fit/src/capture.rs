@@ -186,6 +186,14 @@ impl<'a> ClipFit<'a> {
         SHAPE_FRAMES.min(frames) + (1 + SWEEPS) * frames + 1
     }
 
+    /// Progress steps the passes done so far took.
+    pub fn steps_done(&self) -> usize {
+        let n = self.people.len();
+        let passes = self.progress.passes;
+        let forward = if passes > 0 { SHAPE_FRAMES.min(n) + n } else { 0 };
+        forward + usize::from(passes > 1) + passes.saturating_sub(2) * n
+    }
+
     /// Runs the next pass, calling `step` after each fit; false when all are done.
     pub fn next_pass(&mut self, step: &mut dyn FnMut()) -> Result<bool, FitError> {
         match self.progress.passes {

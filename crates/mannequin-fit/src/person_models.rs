@@ -7,8 +7,8 @@ use mannequin_data::Image;
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
 use crate::network::Network;
-use crate::pose_detector::{Detection, detect, letterbox};
 use crate::pose_landmarker::{MIN_POSE_FLAG, PoseLandmarks, detection_roi, estimate};
+use crate::ssd_detector::{Detection, POSE, letterbox};
 
 const POSE_DETECTION: &[u8] = include_bytes!("../models/pose_detection.onnx");
 const POSE_LANDMARK: &[u8] = include_bytes!("../models/pose_landmark_full.onnx");
@@ -44,7 +44,7 @@ impl PersonModels {
     /// first.
     pub fn people(&self, image: &Image) -> Result<Vec<Person>, FitError> {
         let mut out = Vec::new();
-        for detection in detect(&self.detector, image)? {
+        for detection in POSE.detect(&self.detector, image)? {
             let landmarks = estimate(&self.landmarker, image, detection_roi(&detection))?;
             if landmarks.flag >= MIN_POSE_FLAG {
                 out.push(Person { detection, landmarks });

@@ -9,7 +9,7 @@ use crate::blazepose;
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
 use crate::network::Network;
-use crate::pose_detector::Detection;
+use crate::ssd_detector::Detection;
 
 pub const INPUT_SIZE: usize = 256;
 /// The 33 BlazePose landmarks (then 2 auxiliary points for tracking, and 4 unused).

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use mannequin_data::Image;
-use mannequin_fit::PersonModels;
+use mannequin_fit::{FaceModels, PersonModels};
 use mannequin_io::Npz;
 
 const PICTURES: [&str; 2] = ["astronaut", "camera"];
@@ -122,5 +122,72 @@ fn the_whole_pipeline_finds_mediapipes_landmarks() {
         let seg = array(&npz, "segmentation");
         let mean = p.mask.iter().zip(&seg).map(|(a, b)| (a - b).abs()).sum::<f32>() / seg.len() as f32;
         assert!(mean < 5e-3, "{picture} mask: mean difference {mean}");
+    }
+}
+
+fn face_models() -> &'static FaceModels {
+    static MODELS: OnceLock<FaceModels> = OnceLock::new();
+    MODELS.get_or_init(|| FaceModels::load().unwrap())
+}
+
+#[test]
+fn the_face_networks_match_tflite() {
+    let (detector, landmarker) = (&face_models().detector, &face_models().landmarker);
+    for picture in PICTURES {
+        let npz = Npz::read(data(&format!("face_detection_{picture}.npz"))).unwrap();
+        let out = run(detector, &npz, 1.0 / 127.5, -1.0);
+        for key in ["regressors", "scores"] {
+            let d = max_diff(&out[detector.output_index(key).unwrap()].1, &array(&npz, key));
+            assert!(d < 2e-3, "{picture} face {key}: max difference {d}");
+        }
+        let npz = Npz::read(data(&format!("face_landmark_{picture}.npz"))).unwrap();
+        let out = run(landmarker, &npz, 1.0 / 255.0, 0.0);
+        for key in ["landmarks", "face_flag"] {
+            let d = max_diff(&out[landmarker.output_index(key).unwrap()].1, &array(&npz, key));
+            assert!(d < 2e-3, "{picture} face {key}: max difference {d}");
+        }
+    }
+}
+
+#[test]
+fn the_face_pipeline_finds_mediapipes_face_mesh() {
+    for picture in PICTURES {
+        let npz = Npz::read(data(&format!("face_pipeline_{picture}.npz"))).unwrap();
+        assert_eq!(array(&npz, "found"), [1.0], "the fixture found a face in {picture}");
+        let image = Image::read(&data(&format!("{picture}.png"))).unwrap();
+        let faces = face_models().faces(&image).unwrap();
+        assert!(!faces.is_empty(), "{picture}: no face found");
+        let (w, h) = (image.width as f32, image.height as f32);
+        let d = &faces[0].detection;
+        let want = array(&npz, "detection");
+        let got = [d.bbox[0] / w, d.bbox[1] / h, (d.bbox[2] - d.bbox[0]) / w, (d.bbox[3] - d.bbox[1]) / h];
+        let box_d = max_diff(&got, &want[1..5]);
+        let keys: Vec<f32> = d.keypoints.iter().flat_map(|k| [k[0] / w, k[1] / h]).collect();
+        let key_d = max_diff(&keys, &want[5..]);
+        println!("{picture}: face box off by {box_d}, keypoints by {key_d} (of the picture)");
+        assert!(box_d < 1e-3 && key_d < 1e-3, "{picture}: detection {got:?} {keys:?} vs {want:?}");
+        let face = &faces[0].landmarks;
+        let roi = array(&npz, "roi");
+        let crop_d = [
+            face.roi.cx - roi[0] * w,
+            face.roi.cy - roi[1] * h,
+            face.roi.width - roi[2] * w,
+            face.roi.rotation - roi[4],
+        ];
+        println!("{picture}: face crop centre, side, rotation differ by {crop_d:?}");
+        assert!(crop_d[..3].iter().all(|d| d.abs() < 0.01), "{picture} face crop {:?} vs {roi:?}", face.roi);
+        assert!(crop_d[3].abs() < 2e-3, "{picture} face crop rotation");
+        let want = array(&npz, "landmarks_px");
+        let (mut worst, mut depth) = ((0.0f32, 0), 0.0f32);
+        for (i, got) in face.points.iter().enumerate() {
+            let e = (got[0] - want[3 * i]).hypot(got[1] - want[3 * i + 1]);
+            if e > worst.0 {
+                worst = (e, i);
+            }
+            depth = depth.max((got[2] - want[3 * i + 2]).abs());
+        }
+        println!("{picture}: worst face point {} off by {:.3} px, depth by {depth:.3}", worst.1, worst.0);
+        assert!(worst.0 < 0.05, "{picture}: face point {} is {:.3} px from MediaPipe's", worst.1, worst.0);
+        assert!(depth < 0.05, "{picture}: face depth off by {depth}");
     }
 }

@@ -125,6 +125,7 @@ pub fn run(args: Args) -> Result<()> {
     let mirrored = resolve_mirrors(&fitter, &mut people_read);
     let mut clip = ClipFit::new(&fitter, &people_read, std::mem::take(&mut saved.fit))?;
     let progress = bar(ClipFit::steps(people_read.len()) as u64, "body fit");
+    progress.set_position(clip.steps_done() as u64);
     while clip.next_pass(&mut || progress.inc(1))? {
         saved.fit = clip.progress.clone();
         write_checkpoint(&checkpoint, &run, &saved)?;

@@ -1,0 +1,47 @@
+//! The shipped face models, loaded once: MediaPipe's BlazeFace detector (short range) and face
+//! mesh (Apache-2.0, converted to ONNX by `tools/person_models`; see `models/NOTICE.md`).
+
+use mannequin_data::Image;
+
+use crate::error::FitError;
+use crate::face_landmarker::{FaceLandmarks, MIN_FACE_FLAG, detection_roi, estimate};
+use crate::network::Network;
+use crate::ssd_detector::{Detection, FACE};
+
+const FACE_DETECTION: &[u8] = include_bytes!("../models/face_detection_short_range.onnx");
+const FACE_LANDMARK: &[u8] = include_bytes!("../models/face_landmark.onnx");
+
+/// The two networks, ready to run.
+pub struct FaceModels {
+    pub detector: Network,
+    pub landmarker: Network,
+}
+
+/// One face found in a picture.
+#[derive(Debug, Clone)]
+pub struct Face {
+    pub detection: Detection,
+    pub landmarks: FaceLandmarks,
+}
+
+impl FaceModels {
+    pub fn load() -> Result<Self, FitError> {
+        Ok(Self {
+            detector: Network::load("face_detection_short_range", FACE_DETECTION)?,
+            landmarker: Network::load("face_landmark", FACE_LANDMARK)?,
+        })
+    }
+
+    /// Every face the detector finds whose mesh the landmarker confirms, largest box first.
+    pub fn faces(&self, image: &Image) -> Result<Vec<Face>, FitError> {
+        let mut out = Vec::new();
+        for detection in FACE.detect(&self.detector, image)? {
+            let landmarks = estimate(&self.landmarker, image, detection_roi(&detection))?;
+            if landmarks.flag >= MIN_FACE_FLAG {
+                out.push(Face { detection, landmarks });
+            }
+        }
+        out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
+        Ok(out)
+    }
+}
