@@ -3,6 +3,7 @@
 
 pub mod default_body;
 pub mod error;
+pub mod face_model;
 pub mod kinematics;
 pub mod lbs;
 pub mod lbs_tensor;
@@ -18,6 +19,7 @@ pub mod walk_cycle;
 pub mod weight_transfer;
 
 pub use error::BodyError;
+pub use face_model::FaceModel;
 pub use lbs::{PosedFrames, ShapedBody, forward, frame_skinning, pose_corrected, pose_frames, shape_body};
 pub use lbs_tensor::{BodyTensors, PosedTensors, Rig, forward_tensors, rodrigues_tensor, skin_tensors};
 pub use model::{BodyModel, BodyModelParts, ModelFamily};

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use mannequin_body::{BodyModel, forward, skeletal_animation, skinned_body};
+use mannequin_body::{BodyModel, FaceModel, forward, skeletal_animation, skinned_body};
 use mannequin_mesh::TriMesh;
 use serde_json::json;
 
@@ -113,7 +113,17 @@ fn facts(m: &BodyModel, list_joints: bool) -> Result<serde_json::Value> {
 
 fn info(args: &InfoArgs) -> Result<()> {
     let m = load_body(&args.body)?;
-    let f = facts(&m, args.joints)?;
+    let mut f = facts(&m, args.joints)?;
+    // The face model lives on the full default body's head.
+    let face = (args.body == "default").then(FaceModel::default_face);
+    if let Some(face) = &face {
+        f["face"] = serde_json::json!({
+            "shape_components": face.num_shape(),
+            "shape_variance": face.shape_variance,
+            "expression_units": face.expression_names,
+            "head_vertices": face.vertices.len(),
+        });
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&f)?);
         return Ok(());
@@ -131,6 +141,18 @@ fn info(args: &InfoArgs) -> Result<()> {
         f["uv_coordinates"].as_u64().map_or("none".into(), |n| format!("{n} coordinates"))
     );
     println!("{:<12} {:.3} m (template, Y extent)", "height", f["height_m"].as_f64().unwrap_or(f64::NAN));
+    if let Some(face) = &face {
+        let shares: Vec<String> = face.shape_variance.iter().map(|v| format!("{:.1}", 100.0 * v)).collect();
+        println!(
+            "{:<12} {} shape components keeping {:.1} % of the sampled faces' variance (each, %: {}); {} expression units; {} head vertices",
+            "face",
+            face.num_shape(),
+            100.0 * face.shape_variance.iter().sum::<f32>(),
+            shares.join(" "),
+            face.num_expressions(),
+            face.vertices.len()
+        );
+    }
     if !m.extras.is_empty() {
         println!("{:<12} {}", "extras", m.extras.keys().cloned().collect::<Vec<_>>().join(", "));
     }

@@ -117,6 +117,13 @@ fn info_verbs_print_results_on_stdout_as_a_table_or_json() {
     let table = mannequin(&["body", "info", "--body", "default-lod1"]);
     let text = String::from_utf8_lossy(&table.stdout);
     assert!(text.contains(&format!("vertices     {}", lod1.num_vertices())), "{text}");
+    assert!(!text.contains("face "), "the face model is the full default body's: {text}");
+    let face = mannequin_body::FaceModel::default_face();
+    let full = String::from_utf8_lossy(&mannequin(&["body", "info"]).stdout).to_string();
+    let line =
+        full.lines().find(|l| l.starts_with("face ")).unwrap_or_else(|| panic!("no face line: {full}"));
+    assert!(line.contains(&format!("{} shape components", face.num_shape())), "{line}");
+    assert!(line.contains("52 expression units"), "{line}");
 
     let dir = scratch("cli-splat-info");
     let ply = dir.join("two.ply");
