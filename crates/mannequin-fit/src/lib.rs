@@ -7,6 +7,7 @@ pub mod capture;
 pub mod crop;
 pub mod distance_transform;
 pub mod error;
+pub mod face_landmark_table;
 pub mod face_landmarker;
 pub mod face_models;
 pub mod interpenetration;
