@@ -38,6 +38,7 @@ use crate::levenberg_marquardt::{Summary, minimise};
 use crate::pose_landmarker::{NUM_LANDMARKS, PoseLandmarks};
 use crate::pose_prior;
 use crate::rigid_alignment::best_rotation;
+use crate::robust::pseudo_huber_scale;
 
 /// A landmark counts once its visibility × presence passes this.
 const MIN_CONFIDENCE: f32 = 0.3;
@@ -490,14 +491,7 @@ impl Problem<'_> {
                 (u - observed.points[i][0]) / observed.unit_px,
                 (v - observed.points[i][1]) / observed.unit_px,
             ];
-            let e = d[0].hypot(d[1]);
-            // Pseudo-Huber: ρ(e) = 2δ²(√(1 + (e/δ)²) − 1), split along the error's direction.
-            let scale = if e > 1e-12 {
-                (2.0 * ROBUST_DELTA * ROBUST_DELTA * ((1.0 + (e / ROBUST_DELTA).powi(2)).sqrt() - 1.0)).sqrt()
-                    / e
-            } else {
-                1.0
-            };
+            let scale = pseudo_huber_scale(d[0].hypot(d[1]), ROBUST_DELTA);
             r.push(c.sqrt() * scale * d[0]);
             r.push(c.sqrt() * scale * d[1]);
             let rel = flip(x.as_dvec3()) - hips - observed.world[i];

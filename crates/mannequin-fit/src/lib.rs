@@ -7,6 +7,7 @@ pub mod capture;
 pub mod crop;
 pub mod distance_transform;
 pub mod error;
+pub mod face_fit;
 pub mod face_landmark_table;
 pub mod face_landmarker;
 pub mod face_models;
@@ -19,6 +20,7 @@ pub mod person_models;
 pub mod pose_landmarker;
 pub mod pose_prior;
 pub mod rigid_alignment;
+pub mod robust;
 pub mod ssd_detector;
 
 pub use body_fit::{BodyFit, fit_body};

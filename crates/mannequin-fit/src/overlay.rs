@@ -11,6 +11,8 @@ const BODY: [f32; 3] = [0.55, 0.72, 0.98];
 const BODY_OPACITY: f32 = 0.55;
 const DETECTED: [f32; 3] = [0.1, 0.95, 0.2];
 const REPROJECTED: [f32; 3] = [1.0, 0.15, 0.1];
+/// The face overlay's mesh edges, blended over the photo so the face stays visible.
+const EDGE_OPACITY: f32 = 0.3;
 
 /// The overlay for one fit. `confident[i]` says whether landmark i took part.
 pub fn overlay(
@@ -49,6 +51,37 @@ pub fn overlay(
             disc(&mut out, r, radius, REPROJECTED);
         }
         disc(&mut out, [p[0], p[1]], radius, DETECTED);
+    }
+    out
+}
+
+/// The overlay for a face fit: the fitted head's camera-facing edges (thin, blue), the detected
+/// face-mesh points (green) and the model's points reprojected (red).
+pub fn face_overlay(
+    photo: &Image,
+    detected: &[[f32; 3]],
+    reprojected: &[[f32; 2]],
+    edges: &[[[f32; 2]; 2]],
+) -> Image {
+    let mut out = photo.clone();
+    let mut covered = vec![false; photo.width * photo.height];
+    for [a, b] in edges {
+        let steps = (b[0] - a[0]).hypot(b[1] - a[1]).ceil().max(1.0) as usize;
+        for s in 0..=steps {
+            let t = s as f32 / steps as f32;
+            let (x, y) = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
+            if x >= 0.0 && y >= 0.0 && (x as usize) < photo.width && (y as usize) < photo.height {
+                covered[y as usize * photo.width + x as usize] = true;
+            }
+        }
+    }
+    for (px, _) in out.pixels.iter_mut().zip(&covered).filter(|(_, c)| **c) {
+        *px = std::array::from_fn(|c| px[c] * (1.0 - EDGE_OPACITY) + BODY[c] * EDGE_OPACITY);
+    }
+    let radius = (photo.width.max(photo.height) as f32 / 500.0).max(1.0);
+    for (d, r) in detected.iter().zip(reprojected) {
+        disc(&mut out, [d[0], d[1]], radius, DETECTED);
+        disc(&mut out, *r, radius * 0.7, REPROJECTED);
     }
     out
 }

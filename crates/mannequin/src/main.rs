@@ -11,6 +11,7 @@ mod demo;
 mod dress;
 mod eval;
 mod export;
+mod face;
 mod fit;
 mod garment;
 mod motion;
@@ -53,6 +54,11 @@ enum Command {
     /// Fit the body to a person in a photo: detection, landmarks and mask by the shipped person
     /// models, then shape, pose and camera (body.npz, .obj, .glb, overlay.png, fit.json).
     Fit(fit::Args),
+    /// Fit the default body's face to a portrait: face detection and 468 face-mesh landmarks by
+    /// the shipped face models, then shape, expression and head pose (face.obj, overlay.png,
+    /// fit.json).
+    #[command(subcommand)]
+    Face(face::FaceCommand),
     /// Write motion files (a procedural walk as AMASS .npz).
     #[command(subcommand)]
     Motion(motion::MotionCommand),
@@ -86,6 +92,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Dress(args) => dress::run(args),
         Command::Capture(args) => capture::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Face(cmd) => face::run(cmd),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
         Command::Demo(args) => demo::run(args),

@@ -1,0 +1,274 @@
+//! Fitting the default body's face to one photo (thesis §2.3): the face model's shape α
+//! (Eq. 2.18) and expression, the head's rotation and translation, against MediaPipe's 468
+//! face-mesh landmarks. Each landmark's point on the head (`face_landmark_table.rs`) moves
+//! linearly with α and the expression weights, so the model's landmarks are one matrix product.
+//! Levenberg–Marquardt minimises:
+//!
+//! - the landmarks' reprojection, robust (pseudo-Huber), in 1 % of the inter-ocular distance;
+//! - their relative depth against the mesh's z (weak perspective), at a third of that weight;
+//! - priors: α is unit normal, expressions are pulled to neutral and kept in [0, 1].
+//!
+//! The camera is the body fit's (`picture_camera`): the focal length given or assumed. The fit
+//! starts from the neutral face turned and scaled onto the mesh's 3D points (Kabsch), at the
+//! distance that scale implies. The photometric term (Eq. 2.20) is not in it yet.
+
+use glam::{DMat3, DQuat, DVec3};
+use mannequin_body::{BodyModel, FaceModel};
+use mannequin_data::Camera;
+
+use crate::body_fit::{picture_camera, rotation_gap};
+use crate::error::FitError;
+use crate::face_landmark_table::FaceLandmarkTable;
+use crate::face_landmarker::{FaceLandmarks, NUM_LANDMARKS};
+use crate::levenberg_marquardt::{Summary, minimise};
+use crate::rigid_alignment::best_rotation;
+use crate::robust::pseudo_huber_scale;
+
+/// MediaPipe's outer eye corners (the subject's right, then left).
+pub const OUTER_EYE_CORNERS: [usize; 2] = [33, 263];
+/// Errors are measured in this fraction of the inter-ocular distance.
+const UNIT: f64 = 0.01;
+const ROBUST_DELTA: f64 = 2.0;
+const DEPTH_WEIGHT: f64 = 0.3;
+const SHAPE_WEIGHT: f64 = 1.0;
+const EXPRESSION_WEIGHT: f64 = 0.3;
+/// Per unit an expression weight strays out of [0, 1].
+const BOUND_WEIGHT: f64 = 30.0;
+
+/// The fitted face: its coefficients, the head's placement and the landmarks' errors.
+#[derive(Debug, Clone)]
+pub struct FaceFit {
+    pub shape: Vec<f32>,
+    pub expression: Vec<f32>,
+    /// Camera from head: x_cam = R (x − centre) + t, with x on the default body's rest head.
+    pub rotation: DQuat,
+    pub translation: DVec3,
+    pub centre: DVec3,
+    pub camera: Camera,
+    /// Each landmark's model point projected by the fitted camera.
+    pub reprojected: Vec<[f32; 2]>,
+    /// Each landmark's reprojection error over the inter-ocular distance.
+    pub errors_iod: Vec<f32>,
+    pub stages: Vec<Summary>,
+}
+
+impl FaceFit {
+    pub fn mean_error_iod(&self) -> f32 {
+        self.errors_iod.iter().sum::<f32>() / self.errors_iod.len() as f32
+    }
+
+    /// A point of the default body's rest head in camera space.
+    pub fn to_camera(&self, x: [f32; 3]) -> DVec3 {
+        self.rotation * (DVec3::new(x[0] as f64, x[1] as f64, x[2] as f64) - self.centre) + self.translation
+    }
+}
+
+/// The landmarks' points as linear functions of (α, expression): a base and one column per
+/// coefficient, each 3 × 468 values.
+pub struct FaceFitter {
+    base: Vec<DVec3>,
+    columns: Vec<Vec<DVec3>>,
+    num_shape: usize,
+    centre: DVec3,
+    camera: Camera,
+}
+
+impl FaceFitter {
+    /// For the default body's face, in pictures of `width` × `height` through focal `focal`.
+    pub fn new(width: usize, height: usize, focal: f64) -> Result<Self, FitError> {
+        let body = BodyModel::default_body();
+        let face = FaceModel::default_face();
+        let table = FaceLandmarkTable::default_head();
+        let point = |p: [f32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        let base: Vec<DVec3> =
+            table.positions(&body.v_template, &body.faces)?.into_iter().map(point).collect();
+        let mut slot = vec![None; body.num_vertices()];
+        face.vertices.iter().enumerate().for_each(|(i, &v)| slot[v] = Some(i));
+        let v = face.vertices.len();
+        let column = |basis: &[f32], k: usize| -> Result<Vec<DVec3>, FitError> {
+            table
+                .triangles
+                .iter()
+                .zip(&table.barycentrics)
+                .map(|(&t, b)| {
+                    let mut sum = DVec3::ZERO;
+                    for (corner, &w) in body.faces[t].iter().zip(b) {
+                        let i = slot[*corner as usize].ok_or_else(|| {
+                            FitError::input("face model", "a landmark's triangle leaves the head's vertices")
+                        })?;
+                        let o = &basis[(k * v + i) * 3..(k * v + i) * 3 + 3];
+                        sum += w as f64 * DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
+                    }
+                    Ok(sum)
+                })
+                .collect()
+        };
+        let mut columns = Vec::new();
+        for k in 0..face.num_shape() {
+            columns.push(column(&face.shape_basis, k)?);
+        }
+        for k in 0..face.num_expressions() {
+            columns.push(column(&face.expression_basis, k)?);
+        }
+        let centre = base.iter().copied().sum::<DVec3>() / base.len() as f64;
+        Ok(Self {
+            base,
+            columns,
+            num_shape: face.num_shape(),
+            centre,
+            camera: picture_camera(width, height, focal),
+        })
+    }
+
+    /// The landmarks' points on the rest head for coefficients `c` (α then expression).
+    fn points(&self, c: &[f64]) -> Vec<DVec3> {
+        let mut p = self.base.clone();
+        for (col, &w) in self.columns.iter().zip(c).filter(|(_, w)| **w != 0.0) {
+            p.iter_mut().zip(col).for_each(|(p, d)| *p += w * *d);
+        }
+        p
+    }
+
+    /// Camera-space points for parameters `p` = (rotation vector, translation, coefficients).
+    fn placed(&self, p: &[f64]) -> Vec<DVec3> {
+        let r = quat(p);
+        let t = DVec3::new(p[3], p[4], p[5]);
+        self.points(&p[6..]).into_iter().map(|x| r * (x - self.centre) + t).collect()
+    }
+
+    fn project(&self, x: DVec3) -> [f64; 2] {
+        self.camera.project(x.with_z(x.z.max(1e-3)))
+    }
+
+    /// Fits shape, expression and the head's placement to one face's landmarks.
+    pub fn fit(&self, face: &FaceLandmarks) -> Result<FaceFit, FitError> {
+        if face.points.len() != NUM_LANDMARKS {
+            return Err(FitError::input(
+                "face landmarks",
+                format!("{} given, expected {NUM_LANDMARKS}", face.points.len()),
+            ));
+        }
+        let detected: Vec<[f64; 3]> =
+            face.points.iter().map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect();
+        let [a, b] = OUTER_EYE_CORNERS.map(|i| detected[i]);
+        let iod = (a[0] - b[0]).hypot(a[1] - b[1]);
+        if iod.is_nan() || iod <= 1.0 {
+            return Err(FitError::Picture("the face's eyes are less than a pixel apart".into()));
+        }
+        let unit = UNIT * iod;
+        let mean_z = detected.iter().map(|p| p[2]).sum::<f64>() / detected.len() as f64;
+        let mut params = vec![0.0; 6 + self.columns.len()];
+        self.initial_placement(&detected, &mut params)?;
+        let residuals = |p: &[f64]| -> Vec<f64> {
+            let placed = self.placed(p);
+            let depth = placed.iter().map(|x| x.z).sum::<f64>() / placed.len() as f64;
+            let f = self.camera.intrinsic[0][0];
+            let mut r = Vec::with_capacity(3 * NUM_LANDMARKS + self.columns.len() * 2);
+            for (x, d) in placed.iter().zip(&detected) {
+                let [u, v] = self.project(*x);
+                let e = [(u - d[0]) / unit, (v - d[1]) / unit];
+                let s = pseudo_huber_scale(e[0].hypot(e[1]), ROBUST_DELTA);
+                r.push(s * e[0]);
+                r.push(s * e[1]);
+                // MediaPipe's z: camera-ward negative, on x's pixel scale, about the face.
+                r.push(DEPTH_WEIGHT * (f * (x.z - depth) / depth - (d[2] - mean_z)) / unit);
+            }
+            let (shape, expression) = p[6..].split_at(self.num_shape);
+            r.extend(shape.iter().map(|a| SHAPE_WEIGHT * a));
+            r.extend(expression.iter().map(|e| EXPRESSION_WEIGHT * e));
+            r.extend(expression.iter().map(|e| BOUND_WEIGHT * (e.min(0.0) + (e - 1.0).max(0.0))));
+            r
+        };
+        let placement: Vec<usize> = (0..6).collect();
+        let all: Vec<usize> = (0..params.len()).collect();
+        let stages = vec![
+            minimise(&residuals, &mut params, &placement, 20, 1e-5),
+            minimise(&residuals, &mut params, &all, 30, 1e-5),
+        ];
+        let placed = self.placed(&params);
+        let reprojected: Vec<[f32; 2]> =
+            placed.iter().map(|x| self.project(*x)).map(|[u, v]| [u as f32, v as f32]).collect();
+        let errors_iod = reprojected
+            .iter()
+            .zip(&detected)
+            .map(|(r, d)| ((r[0] as f64 - d[0]).hypot(r[1] as f64 - d[1]) / iod) as f32)
+            .collect();
+        let (shape, expression) = params[6..].split_at(self.num_shape);
+        Ok(FaceFit {
+            shape: shape.iter().map(|&v| v as f32).collect(),
+            expression: expression.iter().map(|&v| v as f32).collect(),
+            rotation: quat(&params),
+            translation: DVec3::new(params[3], params[4], params[5]),
+            centre: self.centre,
+            camera: self.camera.clone(),
+            reprojected,
+            errors_iod,
+            stages,
+        })
+    }
+
+    /// The neutral face turned onto the mesh's 3D points (pixels, y down, z away: the camera's
+    /// axes), scaled as they are, at the depth that scale implies.
+    fn initial_placement(&self, detected: &[[f64; 3]], params: &mut [f64]) -> Result<(), FitError> {
+        let model: Vec<DVec3> = self.base.iter().map(|x| *x - self.centre).collect();
+        let seen: Vec<DVec3> = detected.iter().map(|d| DVec3::new(d[0], d[1], d[2])).collect();
+        let mean = seen.iter().copied().sum::<DVec3>() / seen.len() as f64;
+        let seen: Vec<DVec3> = seen.iter().map(|s| *s - mean).collect();
+        let w = vec![1.0; model.len()];
+        let r = best_rotation(&model, &seen, &w).ok_or_else(|| {
+            FitError::Picture("the face landmarks do not fix the head's orientation".into())
+        })?;
+        let scale = seen.iter().map(|s| s.length_squared()).sum::<f64>().sqrt()
+            / model.iter().map(|m| m.length_squared()).sum::<f64>().sqrt();
+        let f = self.camera.intrinsic[0][0];
+        let (cx, cy) = (self.camera.intrinsic[0][2], self.camera.intrinsic[1][2]);
+        let depth = f / scale;
+        let t = DVec3::new((mean.x - cx) * depth / f, (mean.y - cy) * depth / f, depth);
+        let q = DQuat::from_mat3(&DMat3::from_cols(r.x_axis, r.y_axis, r.z_axis)).normalize();
+        let v = rotation_gap(DQuat::IDENTITY, q);
+        params[..3].copy_from_slice(&v.to_array());
+        params[3..6].copy_from_slice(&t.to_array());
+        Ok(())
+    }
+}
+
+fn quat(p: &[f64]) -> DQuat {
+    let v = DVec3::new(p[0], p[1], p[2]);
+    let angle = v.length();
+    if angle < 1e-12 { DQuat::IDENTITY } else { DQuat::from_axis_angle(v / angle, angle) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::crop::RotatedRect;
+
+    /// Landmarks a known face would give, drawn from the fit's own model: a check of the solver
+    /// (it must find its way back), not of how well the model matches MediaPipe's mesh.
+    #[test]
+    fn the_solver_finds_a_known_face_from_its_own_landmarks() {
+        let fitter = FaceFitter::new(640, 480, 600.0).unwrap();
+        let mut p = vec![0.0; 6 + fitter.columns.len()];
+        p[..3].copy_from_slice(&[std::f64::consts::PI + 0.1, 0.3, 0.05]);
+        p[3..6].copy_from_slice(&[0.03, -0.02, 0.55]);
+        p[6] = 0.8;
+        p[9] = -0.6;
+        p[6 + fitter.num_shape + 24] = 0.5;
+        let placed = fitter.placed(&p);
+        let depth = placed.iter().map(|x| x.z).sum::<f64>() / placed.len() as f64;
+        let points = placed
+            .iter()
+            .map(|x| {
+                let [u, v] = fitter.project(*x);
+                [u as f32, v as f32, (600.0 * (x.z - depth) / depth) as f32]
+            })
+            .collect();
+        let square = RotatedRect { cx: 320.0, cy: 240.0, width: 200.0, height: 200.0, rotation: 0.0 };
+        let face = FaceLandmarks { roi: square, flag: 1.0, points };
+        let fit = fitter.fit(&face).unwrap();
+        assert!(fit.mean_error_iod() < 2e-3, "mean error {} of the eyes' distance", fit.mean_error_iod());
+        let turn = rotation_gap(quat(&p), fit.rotation).length();
+        assert!(turn < 0.03, "the head's rotation is {turn} rad off");
+        assert!((fit.translation - DVec3::new(p[3], p[4], p[5])).length() < 0.02, "{}", fit.translation);
+    }
+}

@@ -1,0 +1,218 @@
+//! `mannequin face fit --image portrait.jpg --out DIR`: finds the largest face, reads its 468
+//! face-mesh landmarks with the shipped face models, and fits the default body's face model to
+//! them (thesis §2.3, `mannequin_fit::face_fit`). Writes the fitted head with colours taken from
+//! the photo, an overlay to check it by, and the fit's numbers.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Subcommand;
+use glam::DVec3;
+use mannequin_body::{BodyModel, FaceModel};
+use mannequin_data::Image;
+use mannequin_fit::face_fit::{FaceFit, FaceFitter, OUTER_EYE_CORNERS};
+use mannequin_fit::overlay::face_overlay;
+use mannequin_fit::{Face, FaceModels};
+use mannequin_mesh::TriMesh;
+use mannequin_mesh::normals::vertex_normals;
+
+use crate::fit::FitArgs;
+
+/// The face mesh reads a 192² crop 1.5× the face box: a box much under 48 pixels is upsampled
+/// past what the network saw in training.
+const MIN_FACE_PX: f32 = 48.0;
+/// A vertex takes the photo's colour when its normal faces the camera at least this much.
+const FACING: f64 = 0.25;
+
+#[derive(Subcommand)]
+pub enum FaceCommand {
+    /// Fit the default body's face (shape, expression, head pose) to a portrait: face.obj with
+    /// colours, overlay.png and fit.json.
+    Fit(FaceFitArgs),
+}
+
+#[derive(clap::Args)]
+pub struct FaceFitArgs {
+    /// The portrait: PNG or JPEG.
+    #[arg(long)]
+    image: PathBuf,
+    #[command(flatten)]
+    fitting: FitArgs,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(command: FaceCommand) -> Result<()> {
+    match command {
+        FaceCommand::Fit(args) => fit(args),
+    }
+}
+
+fn fit(args: FaceFitArgs) -> Result<()> {
+    let start = Instant::now();
+    args.fitting.check()?;
+    if args.fitting.body != "default" {
+        bail!(
+            "--body {}: the face model is the embedded default body's; use --body default",
+            args.fitting.body
+        );
+    }
+    let image = Image::read(&args.image)?;
+    let models = FaceModels::load()?;
+    let faces = models.faces(&image)?;
+    let Some(face) = faces.first() else {
+        bail!(
+            "{}: no face found (the detector finds faces turned less than about 60° from the camera)",
+            args.image.display()
+        );
+    };
+    let side = (face.detection.bbox[2] - face.detection.bbox[0])
+        .max(face.detection.bbox[3] - face.detection.bbox[1]);
+    if side < MIN_FACE_PX {
+        bail!(
+            "{}: the face is {side:.0} pixels across; fitting needs at least {MIN_FACE_PX}",
+            args.image.display()
+        );
+    }
+    let focal = args.fitting.focal(image.width, image.height);
+    let fitter = FaceFitter::new(image.width, image.height, focal)?;
+    let fitted = fitter
+        .fit(&face.landmarks)
+        .with_context(|| format!("fitting the face in {}", args.image.display()))?;
+    let head = head_mesh(&fitted, &image)?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    crate::body::write_mesh(&args.out.join("face.obj"), &head)?;
+    let picture =
+        face_overlay(&image, &face.landmarks.points, &fitted.reprojected, &projected_edges(&head, &fitted));
+    picture.write_png(&args.out.join("overlay.png"))?;
+    let report = report(face, &fitted, start.elapsed().as_secs_f64());
+    mannequin_io::write_atomic(&args.out.join("fit.json"), serde_json::to_string_pretty(&report)?.as_bytes())
+        .with_context(|| format!("writing {}", args.out.join("fit.json").display()))?;
+    tracing::info!(
+        "fitted the face in {}: landmark error {:.2} % of the eyes' distance (mean), {:.2} s; wrote {}",
+        args.image.display(),
+        100.0 * fitted.mean_error_iod(),
+        start.elapsed().as_secs_f64(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The default body's head with the fitted shape and expression, in the body's rest frame,
+/// coloured from the photo where it faces the camera and from its mirror image elsewhere.
+fn head_mesh(fitted: &FaceFit, image: &Image) -> Result<TriMesh> {
+    let body = BodyModel::default_body();
+    let face = FaceModel::default_face();
+    let mut positions = body.v_template.clone();
+    face.apply(&mut positions, &fitted.shape, &fitted.expression)?;
+    let mut index = vec![None; positions.len()];
+    face.vertices.iter().enumerate().for_each(|(i, &v)| index[v] = Some(i as u32));
+    let faces: Vec<[u32; 3]> = body
+        .faces
+        .iter()
+        .filter_map(|f| Some([index[f[0] as usize]?, index[f[1] as usize]?, index[f[2] as usize]?]))
+        .collect();
+    let head: Vec<[f32; 3]> = face.vertices.iter().map(|&v| positions[v]).collect();
+    let normals = vertex_normals(&head, &faces);
+    let seen: Vec<Option<[f32; 3]>> = head
+        .iter()
+        .zip(&normals)
+        .map(|(p, n)| {
+            let x = fitted.to_camera(*p);
+            let n = fitted.rotation * DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
+            if n.dot(-x.normalize()) < FACING {
+                return None;
+            }
+            let [u, v] = fitted.camera.project(x);
+            sample(image, u, v)
+        })
+        .collect();
+    let fallback = {
+        let known: Vec<&[f32; 3]> = seen.iter().flatten().collect();
+        if known.is_empty() {
+            bail!("no vertex of the fitted head faces the camera");
+        }
+        std::array::from_fn(|c| known.iter().map(|k| k[c]).sum::<f32>() / known.len() as f32)
+    };
+    // Where the head is unseen, the colour of the vertex nearest its mirror image (x → −x).
+    let colors = head
+        .iter()
+        .zip(&seen)
+        .map(|(p, s)| {
+            s.unwrap_or_else(|| {
+                let mirror = [-p[0], p[1], p[2]];
+                let nearest = head
+                    .iter()
+                    .enumerate()
+                    .min_by(|a, b| distance2(a.1, &mirror).total_cmp(&distance2(b.1, &mirror)))
+                    .map(|(i, _)| i)
+                    .expect("the head has vertices");
+                seen[nearest].unwrap_or(fallback)
+            })
+        })
+        .collect();
+    Ok(TriMesh { positions: head, faces, uv: None, colors: Some(colors) })
+}
+
+fn distance2(a: &[f32; 3], b: &[f32; 3]) -> f32 {
+    (0..3).map(|c| (a[c] - b[c]).powi(2)).sum()
+}
+
+/// The photo's colour at (u, v), bilinear; None off the picture.
+fn sample(image: &Image, u: f64, v: f64) -> Option<[f32; 3]> {
+    let (x, y) = (u - 0.5, v - 0.5);
+    if !(x >= 0.0 && y >= 0.0 && x <= (image.width - 1) as f64 && y <= (image.height - 1) as f64) {
+        return None;
+    }
+    let (i, j) = ((x as usize).min(image.width - 2), (y as usize).min(image.height - 2));
+    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
+    let (a, b, c, d) = (image.at(i, j), image.at(i + 1, j), image.at(i, j + 1), image.at(i + 1, j + 1));
+    Some(std::array::from_fn(|k| {
+        (a[k] * (1.0 - fx) + b[k] * fx) * (1.0 - fy) + (c[k] * (1.0 - fx) + d[k] * fx) * fy
+    }))
+}
+
+/// The head's edges that face the camera, projected: what the overlay draws.
+fn projected_edges(head: &TriMesh, fitted: &FaceFit) -> Vec<[[f32; 2]; 2]> {
+    let mut edges = Vec::new();
+    for f in &head.faces {
+        let p: Vec<DVec3> = f.iter().map(|&v| fitted.to_camera(head.positions[v as usize])).collect();
+        // Counter-clockwise from outside: facing the camera when the normal points back at it.
+        if (p[1] - p[0]).cross(p[2] - p[0]).dot(p[0]) >= 0.0 {
+            continue;
+        }
+        let uv: Vec<[f32; 2]> =
+            p.iter().map(|x| fitted.camera.project(*x)).map(|[u, v]| [u as f32, v as f32]).collect();
+        edges.extend([[uv[0], uv[1]], [uv[1], uv[2]], [uv[2], uv[0]]]);
+    }
+    edges
+}
+
+fn report(face: &Face, fitted: &FaceFit, seconds: f64) -> serde_json::Value {
+    let mut sorted = fitted.errors_iod.clone();
+    sorted.sort_by(f32::total_cmp);
+    let [a, b] = OUTER_EYE_CORNERS.map(|i| face.landmarks.points[i]);
+    serde_json::json!({
+        "landmark_error_iod": {
+            "mean": fitted.mean_error_iod(),
+            "median": sorted[sorted.len() / 2],
+            "max": sorted[sorted.len() - 1],
+            "per_landmark": fitted.errors_iod,
+        },
+        "inter_ocular_px": (a[0] - b[0]).hypot(a[1] - b[1]),
+        "face_box": face.detection.bbox,
+        "detection_score": face.detection.score,
+        "shape": fitted.shape,
+        "expression": fitted.expression,
+        "head_rotation_xyzw": fitted.rotation.to_array(),
+        "head_translation_m": fitted.translation.to_array(),
+        "focal_px": fitted.camera.intrinsic[0][0],
+        "photometric_error": serde_json::Value::Null,
+        "stages": fitted.stages.iter().map(|s| serde_json::json!({
+            "initial_cost": s.initial_cost, "final_cost": s.final_cost, "iterations": s.iterations,
+        })).collect::<Vec<_>>(),
+        "seconds": seconds,
+    })
+}
