@@ -52,6 +52,13 @@ impl Poses {
         }
     }
 
+    /// `other`'s frames after `self`'s (the shape stays `self`'s): splits joined back into a clip.
+    pub fn append(&mut self, other: &Self) {
+        self.global_orient.extend_from_slice(&other.global_orient);
+        self.body_pose.extend_from_slice(&other.body_pose);
+        self.transl.extend_from_slice(&other.transl);
+    }
+
     /// Reads the arrays, also accepting `thetas (N,72)` in place of `global_orient` + `body_pose`.
     pub fn read(path: &Path) -> Result<Self, DataError> {
         let npz = Npz::read(path)?;

@@ -60,10 +60,7 @@ fn in_camera(
 
 fn all_poses(dataset: &Dataset) -> Poses {
     let mut all = dataset.split("train").expect("train split").poses;
-    let test = dataset.split("test").expect("test split").poses;
-    all.global_orient.extend(test.global_orient);
-    all.body_pose.extend(test.body_pose);
-    all.transl.extend(test.transl);
+    all.append(&dataset.split("test").expect("test split").poses);
     all
 }
 

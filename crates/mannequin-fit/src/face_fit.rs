@@ -12,11 +12,11 @@
 //! starts from the neutral face turned and scaled onto the mesh's 3D points (Kabsch), at the
 //! distance that scale implies. The photometric term (Eq. 2.20) is not in it yet.
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DQuat, DVec3};
 use mannequin_body::{BodyModel, FaceModel};
 use mannequin_data::Camera;
 
-use crate::body_fit::{picture_camera, rotation_gap};
+use crate::body_fit::picture_camera;
 use crate::error::FitError;
 use crate::face_landmark_table::FaceLandmarkTable;
 use crate::face_landmarker::{FaceLandmarks, NUM_LANDMARKS};
@@ -74,10 +74,15 @@ pub struct FaceFitter {
 }
 
 impl FaceFitter {
-    /// For the default body's face, in pictures of `width` × `height` through focal `focal`.
-    pub fn new(width: usize, height: usize, focal: f64) -> Result<Self, FitError> {
-        let body = BodyModel::default_body();
-        let face = FaceModel::default_face();
+    /// For the default body (`body`) and its face model, in pictures of `width` × `height`
+    /// through focal `focal`.
+    pub fn new(
+        body: &BodyModel,
+        face: &FaceModel,
+        width: usize,
+        height: usize,
+        focal: f64,
+    ) -> Result<Self, FitError> {
         let table = FaceLandmarkTable::default_head();
         let point = |p: [f32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
         let base: Vec<DVec3> =
@@ -224,30 +229,29 @@ impl FaceFitter {
         let (cx, cy) = (self.camera.intrinsic[0][2], self.camera.intrinsic[1][2]);
         let depth = f / scale;
         let t = DVec3::new((mean.x - cx) * depth / f, (mean.y - cy) * depth / f, depth);
-        let q = DQuat::from_mat3(&DMat3::from_cols(r.x_axis, r.y_axis, r.z_axis)).normalize();
-        let v = rotation_gap(DQuat::IDENTITY, q);
-        params[..3].copy_from_slice(&v.to_array());
+        params[..3].copy_from_slice(&DQuat::from_mat3(&r).normalize().to_scaled_axis().to_array());
         params[3..6].copy_from_slice(&t.to_array());
         Ok(())
     }
 }
 
+/// The head's rotation: the parameters' first three, a rotation vector.
 fn quat(p: &[f64]) -> DQuat {
-    let v = DVec3::new(p[0], p[1], p[2]);
-    let angle = v.length();
-    if angle < 1e-12 { DQuat::IDENTITY } else { DQuat::from_axis_angle(v / angle, angle) }
+    DQuat::from_scaled_axis(DVec3::new(p[0], p[1], p[2]))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::body_fit::rotation_gap;
     use crate::crop::RotatedRect;
 
     /// Landmarks a known face would give, drawn from the fit's own model: a check of the solver
     /// (it must find its way back), not of how well the model matches MediaPipe's mesh.
     #[test]
     fn the_solver_finds_a_known_face_from_its_own_landmarks() {
-        let fitter = FaceFitter::new(640, 480, 600.0).unwrap();
+        let (body, face) = (BodyModel::default_body(), FaceModel::default_face());
+        let fitter = FaceFitter::new(&body, &face, 640, 480, 600.0).unwrap();
         let mut p = vec![0.0; 6 + fitter.columns.len()];
         p[..3].copy_from_slice(&[std::f64::consts::PI + 0.1, 0.3, 0.05]);
         p[3..6].copy_from_slice(&[0.03, -0.02, 0.55]);

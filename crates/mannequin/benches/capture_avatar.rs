@@ -31,23 +31,11 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// Every frame's poses of a dataset, its splits in frame order.
+/// Every frame's poses of the synthetic capture: its training frames, then its test frames.
 fn all_poses(dataset: &Dataset) -> Poses {
-    let mut all: Option<Poses> = None;
-    let mut ranges: Vec<_> = dataset.splits.iter().filter(|(name, _)| *name != "val").collect();
-    ranges.sort_by_key(|(_, r)| r.frames()[0]);
-    for (name, _) in ranges {
-        let part = dataset.split(name).unwrap().poses;
-        match &mut all {
-            None => all = Some(part),
-            Some(a) => {
-                a.global_orient.extend(part.global_orient);
-                a.body_pose.extend(part.body_pose);
-                a.transl.extend(part.transl);
-            }
-        }
-    }
-    all.unwrap()
+    let mut all = dataset.split("train").unwrap().poses;
+    all.append(&dataset.split("test").unwrap().poses);
+    all
 }
 
 /// The synthetic subject's frames with their true masks, camera and poses, split as `like` is.

@@ -77,11 +77,12 @@ fn fit(args: FaceFitArgs) -> Result<()> {
         );
     }
     let focal = args.fitting.focal(image.width, image.height);
-    let fitter = FaceFitter::new(image.width, image.height, focal)?;
+    let (body, face_model) = (BodyModel::default_body(), FaceModel::default_face());
+    let fitter = FaceFitter::new(&body, &face_model, image.width, image.height, focal)?;
     let fitted = fitter
         .fit(&face.landmarks)
         .with_context(|| format!("fitting the face in {}", args.image.display()))?;
-    let head = head_mesh(&fitted, &image)?;
+    let head = head_mesh(&body, &face_model, &fitted, &image)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     crate::body::write_mesh(&args.out.join("face.obj"), &head)?;
     let picture =
@@ -102,9 +103,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
 
 /// The default body's head with the fitted shape and expression, in the body's rest frame,
 /// coloured from the photo where it faces the camera and from its mirror image elsewhere.
-fn head_mesh(fitted: &FaceFit, image: &Image) -> Result<TriMesh> {
-    let body = BodyModel::default_body();
-    let face = FaceModel::default_face();
+fn head_mesh(body: &BodyModel, face: &FaceModel, fitted: &FaceFit, image: &Image) -> Result<TriMesh> {
     let mut positions = body.v_template.clone();
     face.apply(&mut positions, &fitted.shape, &fitted.expression)?;
     let mut index = vec![None; positions.len()];

@@ -37,9 +37,7 @@ fn a_sliding_clip_becomes_a_dataset_whose_body_slides_with_the_person() {
     assert_eq!((train.frames.len(), test.frames.len()), (4, 1));
     let model = mannequin_body::BodyModel::default_body();
     let mut poses = train.poses.clone();
-    poses.global_orient.extend(&test.poses.global_orient);
-    poses.body_pose.extend(&test.poses.body_pose);
-    poses.transl.extend(&test.poses.transl);
+    poses.append(&test.poses);
     let camera = data.camera(0);
     // The head and neck: seen in every frame, unlike the legs (out of the picture) or the hands
     // (on the camera, where the landmarks jump by tens of pixels as the crop moves).
