@@ -1,6 +1,6 @@
 // Loads a .glb with three.js's GLTFLoader in Node (no browser) and reports what a web viewer would
 // play: skinned meshes, bone counts, animation clips, and the posed mesh's bounding box at the
-// first and last key; then each morph-animated mesh (a cloth cache) and its box at the last key. Exits 1 if there is no skinned mesh or no animation, 2 if three.js is missing.
+// first and last key; then each morph-animated mesh (a cloth cache) and its box at the last key. Exits 1 if there is neither an animated skinned mesh nor a morph mesh, 2 if three.js is missing.
 //
 // Install three.js once:  npm install --prefix "$HOME/.cache/three-check" three
 // Usage:                  node tools/gltf_three_check.mjs FILE.glb
@@ -73,10 +73,12 @@ const morphs = [];
 gltf.scene.traverse((o) => o.isMesh && !o.isSkinnedMesh && o.morphTargetInfluences && morphs.push(o));
 for (const m of morphs) {
   const targets = m.geometry.morphAttributes.position.length;
-  console.log(`  morph mesh '${m.name}': ${m.geometry.attributes.position.count} vertices, ${targets} targets`);
+  const names = Object.keys(m.morphTargetDictionary || {});
+  const named = names.length ? ` (${names.join(", ")})` : "";
+  console.log(`  morph mesh '${m.name}': ${m.geometry.attributes.position.count} vertices, ${targets} targets${named}`);
   if (gltf.animations.length) {
     const t = gltf.animations[0].duration;
     console.log(`  ${m.name} box at t=${t.toFixed(4)}: ${posedBox(m, t)}`);
   }
 }
-process.exit(skinned.length && gltf.animations.length ? 0 : 1);
+process.exit((skinned.length && gltf.animations.length) || morphs.length ? 0 : 1);

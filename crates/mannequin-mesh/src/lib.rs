@@ -22,7 +22,10 @@ pub mod tri_mesh;
 pub use area::double_areas;
 pub use closest_point::{ClosestPoint, SurfacePoint};
 pub use file_error::MeshFileError;
-pub use gltf::{MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, write_glb, write_scene_glb};
+pub use gltf::{
+    BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh,
+    write_blend_shape_glb, write_glb, write_scene_glb,
+};
 pub use gradient::gradient_operator;
 pub use laplacian::cotan_laplacian;
 pub use mass::{MassKind, mass_matrix, vertex_areas};

@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use mannequin_mesh::{
-    MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh, UvLayout, write_glb, write_scene_glb,
+    BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh,
+    UvLayout, write_blend_shape_glb, write_glb, write_scene_glb,
 };
 use serde_json::Value;
 
@@ -266,13 +267,24 @@ impl Glb {
         let animation = &self.doc["animations"][0];
         let channel = animation["channels"]
             .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["target"]["node"] == node && c["target"]["path"] == "weights")
-            .unwrap();
-        let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
-        let times: Vec<f32> = self.accessor(&sampler["input"]).into_iter().map(|r| r[0]).collect();
-        let values: Vec<f32> = self.accessor(&sampler["output"]).into_iter().map(|r| r[0]).collect();
+            .into_iter()
+            .flatten()
+            .find(|c| c["target"]["node"] == node && c["target"]["path"] == "weights");
+        // Without a channel the mesh shows its default weights.
+        let (times, values): (Vec<f32>, Vec<f32>) = match channel {
+            Some(channel) => {
+                let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
+                let times = self.accessor(&sampler["input"]).into_iter().map(|r| r[0]).collect();
+                (times, self.accessor(&sampler["output"]).into_iter().map(|r| r[0]).collect())
+            }
+            None => {
+                let mesh = &self.doc["meshes"][nodes[node]["mesh"].as_u64().unwrap() as usize];
+                (
+                    vec![0.0],
+                    mesh["weights"].as_array().unwrap().iter().map(|w| w.as_f64().unwrap() as f32).collect(),
+                )
+            }
+        };
         let k = times.iter().rposition(|&x| x <= t).unwrap().min(times.len().saturating_sub(2));
         let s =
             if times.len() < 2 { 0.0 } else { ((t - times[k]) / (times[k + 1] - times[k])).clamp(0.0, 1.0) };
@@ -616,4 +628,136 @@ fn vertex_cache_passes_the_validator_and_three_js() {
     let line = three.lines().find_map(|l| l.trim().strip_prefix("sheet box at t=0.3000: ")).expect(&three);
     // Frame 3: x in [0, 1.6], y = 0.7, z in [0, 1].
     assert_eq!(line, "min (0.0000, 0.7000, 0.0000) max (1.6000, 0.7000, 1.0000)", "{three}");
+}
+
+/// The sheet with colours and two named shapes: `lift` raises the middle vertex by 0.2, `spread`
+/// moves every vertex by 0.1 per unit of x along x; shown at weights (0.5, 0).
+fn sheet_shapes() -> BlendShapeMesh {
+    let mut mesh = sheet_cache().mesh;
+    mesh.colors = Some((0..9).map(|i| [i as f32 / 8.0, 0.5, 1.0 - i as f32 / 8.0]).collect());
+    let lift = (0..9).map(|i| if i == 4 { [0.0, 0.2, 0.0] } else { [0.0; 3] }).collect();
+    let spread = mesh.positions.iter().map(|p| [0.1 * p[0], 0.0, 0.0]).collect();
+    BlendShapeMesh {
+        name: "sheet".into(),
+        mesh,
+        shape_names: vec!["lift".into(), "spread".into()],
+        shapes: vec![lift, spread],
+        weights: vec![0.5, 0.0],
+    }
+}
+
+/// The sheet's vertices at shape weights `w`, computed from the definition above.
+fn sheet_at(w: [f32; 2]) -> Vec<Vec3> {
+    sheet_cache()
+        .mesh
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let lift = if i == 4 { 0.2 * w[0] } else { 0.0 };
+            Vec3::new(p[0] * (1.0 + 0.1 * w[1]), p[1] + lift, p[2])
+        })
+        .collect()
+}
+
+fn assert_is_sheet_at(got: &[Vec3], w: [f32; 2], what: &str) {
+    let want = sheet_at(w);
+    assert_eq!(got.len(), 12, "{what}: 9 vertices, the seam column's 3 written twice");
+    for g in got {
+        let nearest = want.iter().map(|v| (*g - *v).length()).fold(f32::INFINITY, f32::min);
+        assert!(nearest < 1e-5, "{what}: {g} is no vertex of the sheet at weights {w:?}");
+    }
+}
+
+/// Read back: the shapes' names, the colours, the default weights, and an animation that keys
+/// the weights and turns the node.
+#[test]
+fn blend_shapes_keep_their_names_weights_and_keys() {
+    let shapes = sheet_shapes();
+    let path = temp_file("shapes.glb");
+    write_blend_shape_glb(&path, &shapes, None).unwrap();
+    let glb = Glb::read(&path);
+    let mesh = &glb.doc["meshes"][0];
+    assert_eq!(mesh["extras"]["targetNames"], serde_json::json!(["lift", "spread"]));
+    let colors = glb.accessor(&mesh["primitives"][0]["attributes"]["COLOR_0"]);
+    let positions = glb.accessor(&mesh["primitives"][0]["attributes"]["POSITION"]);
+    for (c, p) in colors.iter().zip(&positions) {
+        let i = sheet_cache().mesh.positions.iter().position(|q| q == &[p[0], p[1], p[2]]).unwrap();
+        assert_eq!(c, &[i as f32 / 8.0, 0.5, 1.0 - i as f32 / 8.0], "the colour of vertex {i}");
+    }
+    assert!(glb.doc.get("animations").is_none());
+    assert_is_sheet_at(&glb.morph_at("sheet", 0.0), [0.5, 0.0], "default weights");
+
+    let turn = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+    let animation = BlendShapeAnimation {
+        fps: 10.0,
+        weights: vec![vec![0.0, 0.0], vec![1.0, 0.0], vec![0.0, 1.0]],
+        node_pose: Some(vec![
+            ([0.0, 0.0, 0.0, 1.0], [0.0; 3]),
+            ([0.0, 0.0, 0.0, 1.0], [0.0; 3]),
+            (turn.to_array(), [0.0, 0.0, 1.0]),
+        ]),
+    };
+    write_blend_shape_glb(&path, &shapes, Some(&animation)).unwrap();
+    let glb = Glb::read(&path);
+    for (t, w) in
+        [(0.0, [0.0, 0.0]), (0.05, [0.5, 0.0]), (0.1, [1.0, 0.0]), (0.15, [0.5, 0.5]), (0.2, [0.0, 1.0])]
+    {
+        assert_is_sheet_at(&glb.morph_at("sheet", t), w, &format!("t = {t}"));
+    }
+    let animation_json = &glb.doc["animations"][0];
+    let keyed = |property: &str| -> Vec<Vec<f32>> {
+        let channel = animation_json["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["target"]["path"] == property)
+            .unwrap();
+        glb.accessor(&animation_json["samplers"][channel["sampler"].as_u64().unwrap() as usize]["output"])
+    };
+    assert_eq!(keyed("translation")[2], vec![0.0, 0.0, 1.0]);
+    let last = Quat::from_slice(&keyed("rotation")[2]);
+    assert!(last.angle_between(turn) < 1e-5, "{last} vs {turn}");
+
+    let mut bad = shapes.clone();
+    bad.shapes[1].pop();
+    let e = write_blend_shape_glb(&path, &bad, None).unwrap_err().to_string();
+    assert!(e.contains("sheet.shapes[1] (spread)") && e.contains("9 offsets"), "{e}");
+    let mut short = animation.clone();
+    short.weights[1].pop();
+    let e = write_blend_shape_glb(&path, &shapes, Some(&short)).unwrap_err().to_string();
+    assert!(e.contains("animation.weights[1]") && e.contains("2 finite weights"), "{e}");
+    std::fs::remove_file(&path).unwrap();
+}
+
+/// The validator and three.js on the blend shapes: three.js names the targets and plays the
+/// weights to the last key (the spread sheet turned a quarter about y, moved 1 along z).
+#[test]
+fn blend_shapes_pass_the_validator_and_three_js() {
+    let shapes = sheet_shapes();
+    let animation = BlendShapeAnimation {
+        fps: 10.0,
+        weights: vec![vec![0.0, 0.0], vec![0.0, 1.0]],
+        node_pose: Some(vec![
+            ([0.0, 0.0, 0.0, 1.0], [0.0; 3]),
+            (Quat::from_rotation_y(std::f32::consts::FRAC_PI_2).to_array(), [0.0, 0.0, 1.0]),
+        ]),
+    };
+    let path = temp_file("shapes-check.glb");
+    write_blend_shape_glb(&path, &shapes, Some(&animation)).unwrap();
+    let (report, three) = (KHRONOS_VALIDATOR.run(&path), THREE_JS.run(&path));
+    std::fs::remove_file(&path).unwrap();
+    if let Some(report) = report {
+        assert!(report.contains(" 0 errors, 0 warnings"), "{report}");
+    }
+    let Some(three) = three else { return };
+    assert!(three.contains("morph mesh 'sheet': 12 vertices, 2 targets (lift, spread)"), "{three}");
+    let line = three.lines().find_map(|l| l.trim().strip_prefix("sheet box at t=0.1000: ")).expect(&three);
+    // Spread: x in [0, 1.1], y = 1, z in [0, 1]; turned by +90° about y (x → −z, z → x), then z + 1.
+    let got: Vec<f32> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let want = [0.0, 1.0, -0.1, 1.0, 1.0, 1.0];
+    assert!(got.len() == 6 && got.iter().zip(want).all(|(g, w)| (g - w).abs() < 2e-4), "{three}");
 }

@@ -121,10 +121,14 @@ fn encode(
         doc["animations"] =
             json!([{ "name": "motion", "samplers": track.samplers, "channels": track.channels }]);
     }
+    finish(path, doc, buffer)
+}
+
+/// The GLB bytes of `doc` with `buffer` as its one buffer.
+pub(crate) fn finish(path: &Path, mut doc: Value, buffer: Buffer) -> Result<Vec<u8>, MeshFileError> {
     doc["buffers"] = json!([{ "byteLength": buffer.bytes.len() }]);
     doc["bufferViews"] = json!(buffer.views);
     doc["accessors"] = json!(buffer.accessors);
-
     let json = serde_json::to_vec(&doc).expect("a serde_json::Value always serialises");
     let bytes = glb(&json, &buffer.bytes);
     if u32::try_from(bytes.len()).is_err() {
@@ -187,13 +191,13 @@ fn primitive(path: &Path, skinned: &SkinnedMesh, buffer: &mut Buffer) -> Result<
 
 /// The samplers and channels of the file's one animation.
 #[derive(Default)]
-struct Track {
-    samplers: Vec<Value>,
-    channels: Vec<Value>,
+pub(crate) struct Track {
+    pub samplers: Vec<Value>,
+    pub channels: Vec<Value>,
 }
 
 impl Track {
-    fn add(&mut self, sampler: Value, node: usize, property: &str) {
+    pub(crate) fn add(&mut self, sampler: Value, node: usize, property: &str) {
         self.channels
             .push(json!({ "sampler": self.samplers.len(), "target": { "node": node, "path": property } }));
         self.samplers.push(sampler);
@@ -225,7 +229,7 @@ fn skeletal_tracks(
 
 /// Normalises each quaternion and flips its sign where needed so consecutive keys lie in the same
 /// hemisphere: q and −q are the same rotation, but interpolating between them takes the long way.
-fn continuous_rotations(track: impl Iterator<Item = [f32; 4]>) -> Vec<[f32; 4]> {
+pub(crate) fn continuous_rotations(track: impl Iterator<Item = [f32; 4]>) -> Vec<[f32; 4]> {
     let mut out: Vec<[f32; 4]> = Vec::new();
     for q in track {
         let mut q = Vec4::from(q).normalize();

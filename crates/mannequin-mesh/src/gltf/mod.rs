@@ -2,6 +2,7 @@
 //! it, written with our own code so that the exact layout (bind pose, inverse bind matrices,
 //! sampler times, morph keys) is under test.
 
+mod blend_shapes;
 mod buffer;
 mod document;
 mod glb;
@@ -10,6 +11,7 @@ mod model;
 mod morph;
 mod split;
 
+pub use blend_shapes::{BlendShapeAnimation, BlendShapeMesh, write_blend_shape_glb};
 pub use document::{write_glb, write_scene_glb};
 pub use model::{SkeletalAnimation, Skeleton, SkinnedMesh};
 pub use morph::MorphSequence;
