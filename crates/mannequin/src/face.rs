@@ -1,7 +1,8 @@
 //! `mannequin face fit --image portrait.jpg --out DIR`: finds the largest face, reads its 468
 //! face-mesh landmarks with the shipped face models, and fits the default body's face model to
 //! them (thesis §2.3, `mannequin_fit::face_fit`). Writes the fitted head with colours taken from
-//! the photo, an overlay to check it by, and the fit's numbers.
+//! the photo (with its expressions as blend shapes in `face.glb`), an overlay to check it by, and
+//! the fit's numbers.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -14,8 +15,8 @@ use mannequin_data::Image;
 use mannequin_fit::face_fit::{FaceFit, FaceFitter, OUTER_EYE_CORNERS};
 use mannequin_fit::overlay::face_overlay;
 use mannequin_fit::{Face, FaceModels};
-use mannequin_mesh::TriMesh;
 use mannequin_mesh::normals::vertex_normals;
+use mannequin_mesh::{BlendShapeMesh, TriMesh, write_blend_shape_glb};
 
 use crate::fit::FitArgs;
 
@@ -28,7 +29,7 @@ const FACING: f64 = 0.25;
 #[derive(Subcommand)]
 pub enum FaceCommand {
     /// Fit the default body's face (shape, expression, head pose) to a portrait: face.obj with
-    /// colours, overlay.png and fit.json.
+    /// colours, face.glb with the 52 expressions as morph targets, overlay.png and fit.json.
     Fit(FaceFitArgs),
 }
 
@@ -85,6 +86,8 @@ fn fit(args: FaceFitArgs) -> Result<()> {
     let head = head_mesh(&body, &face_model, &fitted, &image)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     crate::body::write_mesh(&args.out.join("face.obj"), &head)?;
+    let shapes = expression_shapes(&face_model, &head, &fitted.expression);
+    write_blend_shape_glb(args.out.join("face.glb"), &shapes, None)?;
     let picture =
         face_overlay(&image, &face.landmarks.points, &fitted.reprojected, &projected_edges(&head, &fitted));
     picture.write_png(&args.out.join("overlay.png"))?;
@@ -153,6 +156,32 @@ fn head_mesh(body: &BodyModel, face: &FaceModel, fitted: &FaceFit, image: &Image
         })
         .collect();
     Ok(TriMesh { positions: head, faces, uv: None, colors: Some(colors) })
+}
+
+/// The fitted head as blend shapes: the 52 expression units as named morph targets over the
+/// head without its expression, shown at the fitted weights (so a viewer shows the fitted face,
+/// and moving a weight animates it).
+fn expression_shapes(face: &FaceModel, head: &TriMesh, expression: &[f32]) -> BlendShapeMesh {
+    let v = face.vertices.len();
+    let shapes: Vec<Vec<[f32; 3]>> = (0..face.num_expressions())
+        .map(|k| {
+            face.expression_basis[k * v * 3..(k + 1) * v * 3]
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect()
+        })
+        .collect();
+    let mut neutral = head.clone();
+    for (shape, &w) in shapes.iter().zip(expression) {
+        neutral.positions.iter_mut().zip(shape).for_each(|(p, d)| (0..3).for_each(|c| p[c] -= w * d[c]));
+    }
+    BlendShapeMesh {
+        name: "face".into(),
+        mesh: neutral,
+        shape_names: face.expression_names.clone(),
+        shapes,
+        weights: expression.to_vec(),
+    }
 }
 
 fn distance2(a: &[f32; 3], b: &[f32; 3]) -> f32 {

@@ -30,6 +30,50 @@ fn a_portrait_gets_its_face_fitted_within_three_percent_of_the_eyes_distance() {
     let text = std::fs::read_to_string(out.join("face.obj")).unwrap();
     let coloured = text.lines().filter(|l| l.starts_with("v ") && l.split_whitespace().count() == 7).count();
     assert!(coloured > 4000, "{coloured} coloured vertices");
+    face_glb_plays_the_fitted_expression(&out, &report);
+}
+
+/// face.glb holds the head without its expression and the 52 units as named targets, shown at
+/// the fitted weights: read back, the neutral head plus the weighted targets is face.obj.
+fn face_glb_plays_the_fitted_expression(out: &Path, report: &serde_json::Value) {
+    let bytes = std::fs::read(out.join("face.glb")).unwrap();
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[0..4], b"glTF");
+    let json_len = u32_at(12);
+    let doc: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin = &bytes[20 + json_len + 8..];
+    let mesh = &doc["meshes"][0];
+    let names: Vec<&str> =
+        mesh["extras"]["targetNames"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+    assert_eq!(names, mannequin_body::FaceModel::default_face().expression_names);
+    let weights: Vec<f64> = mesh["weights"].as_array().unwrap().iter().map(|w| w.as_f64().unwrap()).collect();
+    let fitted: Vec<f64> =
+        report["expression"].as_array().unwrap().iter().map(|w| w.as_f64().unwrap()).collect();
+    assert!(weights.iter().zip(&fitted).all(|(a, b)| (a - b).abs() < 1e-6), "{weights:?} vs {fitted:?}");
+    let vec3s = |accessor: &serde_json::Value| -> Vec<[f32; 3]> {
+        let a = &doc["accessors"][accessor.as_u64().unwrap() as usize];
+        let view = &doc["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+        let start = view["byteOffset"].as_u64().unwrap() as usize;
+        let f = |i: usize| f32::from_le_bytes(bin[start + 4 * i..start + 4 * i + 4].try_into().unwrap());
+        (0..a["count"].as_u64().unwrap() as usize).map(|v| [f(3 * v), f(3 * v + 1), f(3 * v + 2)]).collect()
+    };
+    let primitive = &mesh["primitives"][0];
+    let mut shown = vec3s(&primitive["attributes"]["POSITION"]);
+    for (target, &w) in primitive["targets"].as_array().unwrap().iter().zip(&weights) {
+        for (p, d) in shown.iter_mut().zip(vec3s(&target["POSITION"])) {
+            (0..3).for_each(|c| p[c] += w as f32 * d[c]);
+        }
+    }
+    let obj = mannequin_mesh::read_obj(out.join("face.obj")).unwrap();
+    assert!(shown.len() > 4000 && shown.len() <= obj.positions.len(), "{} glTF vertices", shown.len());
+    let gap = |a: &[f32; 3]| {
+        obj.positions
+            .iter()
+            .map(|b| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f32::max))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let worst = shown.iter().map(gap).fold(0.0, f32::max);
+    assert!(worst < 1e-5, "a vertex of face.glb at its weights is {worst} m from face.obj's");
 }
 
 #[test]
