@@ -17,10 +17,11 @@ use mannequin_body::{BodyModel, FaceModel};
 use mannequin_data::Camera;
 
 use crate::body_fit::picture_camera;
+use crate::body_fit::rotation_gap;
 use crate::error::FitError;
 use crate::face_landmark_table::FaceLandmarkTable;
 use crate::face_landmarker::{FaceLandmarks, NUM_LANDMARKS};
-use crate::levenberg_marquardt::{Summary, minimise};
+use crate::levenberg_marquardt::{Summary, minimise_with};
 use crate::rigid_alignment::best_rotation;
 use crate::robust::pseudo_huber_scale;
 
@@ -34,6 +35,22 @@ const SHAPE_WEIGHT: f64 = 1.0;
 const EXPRESSION_WEIGHT: f64 = 0.3;
 /// Per unit an expression weight strays out of [0, 1].
 const BOUND_WEIGHT: f64 = 30.0;
+/// A video frame's pull toward the previous frame's fit: per radian the head turns, per metre it
+/// moves, and per unit an expression weight changes.
+const ROTATION_SMOOTHING: f64 = 100.0;
+const TRANSLATION_SMOOTHING: f64 = 300.0;
+const EXPRESSION_SMOOTHING: f64 = 5.0;
+/// The finite differences' half-width.
+const STEP: f64 = 1e-5;
+
+/// One frame's fitting problem: its landmarks, the error unit, and the fit it is pulled toward.
+struct Problem<'a> {
+    detected: &'a [[f64; 3]],
+    /// Pixels per residual unit (a fraction of the inter-ocular distance).
+    unit: f64,
+    mean_z: f64,
+    previous: Option<&'a FaceFit>,
+}
 
 /// The fitted face: its coefficients, the head's placement and the landmarks' errors.
 #[derive(Debug, Clone)]
@@ -147,6 +164,32 @@ impl FaceFitter {
 
     /// Fits shape, expression and the head's placement to one face's landmarks.
     pub fn fit(&self, face: &FaceLandmarks) -> Result<FaceFit, FitError> {
+        self.solve(face, None, None)
+    }
+
+    /// Fits one video frame: the shape held at `shape` (the video's), the expression and the
+    /// head's placement started from the previous frame's fit and pulled toward it.
+    pub fn track(
+        &self,
+        face: &FaceLandmarks,
+        shape: &[f32],
+        previous: Option<&FaceFit>,
+    ) -> Result<FaceFit, FitError> {
+        if shape.len() != self.num_shape {
+            return Err(FitError::input(
+                "face shape",
+                format!("{} coefficients given, the model has {}", shape.len(), self.num_shape),
+            ));
+        }
+        self.solve(face, Some(shape), previous)
+    }
+
+    fn solve(
+        &self,
+        face: &FaceLandmarks,
+        shape: Option<&[f32]>,
+        previous: Option<&FaceFit>,
+    ) -> Result<FaceFit, FitError> {
         if face.points.len() != NUM_LANDMARKS {
             return Err(FitError::input(
                 "face landmarks",
@@ -160,36 +203,40 @@ impl FaceFitter {
         if iod.is_nan() || iod <= 1.0 {
             return Err(FitError::Picture("the face's eyes are less than a pixel apart".into()));
         }
-        let unit = UNIT * iod;
         let mean_z = detected.iter().map(|p| p[2]).sum::<f64>() / detected.len() as f64;
         let mut params = vec![0.0; 6 + self.columns.len()];
-        self.initial_placement(&detected, &mut params)?;
-        let residuals = |p: &[f64]| -> Vec<f64> {
-            let placed = self.placed(p);
-            let depth = placed.iter().map(|x| x.z).sum::<f64>() / placed.len() as f64;
-            let f = self.camera.intrinsic[0][0];
-            let mut r = Vec::with_capacity(3 * NUM_LANDMARKS + self.columns.len() * 2);
-            for (x, d) in placed.iter().zip(&detected) {
-                let [u, v] = self.project(*x);
-                let e = [(u - d[0]) / unit, (v - d[1]) / unit];
-                let s = pseudo_huber_scale(e[0].hypot(e[1]), ROBUST_DELTA);
-                r.push(s * e[0]);
-                r.push(s * e[1]);
-                // MediaPipe's z: camera-ward negative, on x's pixel scale, about the face.
-                r.push(DEPTH_WEIGHT * (f * (x.z - depth) / depth - (d[2] - mean_z)) / unit);
+        match previous {
+            Some(prev) => {
+                params[..3].copy_from_slice(&prev.rotation.to_scaled_axis().to_array());
+                params[3..6].copy_from_slice(&prev.translation.to_array());
+                let coefficients = prev.shape.iter().chain(&prev.expression);
+                params[6..].iter_mut().zip(coefficients).for_each(|(p, &c)| *p = c as f64);
             }
-            let (shape, expression) = p[6..].split_at(self.num_shape);
-            r.extend(shape.iter().map(|a| SHAPE_WEIGHT * a));
-            r.extend(expression.iter().map(|e| EXPRESSION_WEIGHT * e));
-            r.extend(expression.iter().map(|e| BOUND_WEIGHT * (e.min(0.0) + (e - 1.0).max(0.0))));
-            r
-        };
+            None => self.initial_placement(&detected, &mut params)?,
+        }
+        if let Some(shape) = shape {
+            params[6..6 + self.num_shape].iter_mut().zip(shape).for_each(|(p, &a)| *p = a as f64);
+        }
+        let problem = Problem { detected: &detected, unit: UNIT * iod, mean_z, previous };
+        let residuals = |p: &[f64]| self.residuals(&self.placed(p), p, &problem);
         let placement: Vec<usize> = (0..6).collect();
-        let all: Vec<usize> = (0..params.len()).collect();
-        let stages = vec![
-            minimise(&residuals, &mut params, &placement, 20, 1e-5),
-            minimise(&residuals, &mut params, &all, 30, 1e-5),
-        ];
+        let expression = 6 + self.num_shape..params.len();
+        let free: Vec<usize> = match shape {
+            Some(_) => placement.iter().copied().chain(expression).collect(),
+            None => (0..params.len()).collect(),
+        };
+        let problem = &problem;
+        let jacobian = |free: &[usize]| {
+            let free = free.to_vec();
+            move |x: &[f64]| self.jacobian(x, &free, problem)
+        };
+        let stages = match previous {
+            Some(_) => vec![minimise_with(&residuals, &jacobian(&free), &mut params, &free, 10)],
+            None => vec![
+                minimise_with(&residuals, &jacobian(&placement), &mut params, &placement, 20),
+                minimise_with(&residuals, &jacobian(&free), &mut params, &free, 30),
+            ],
+        };
         let placed = self.placed(&params);
         let reprojected: Vec<[f32; 2]> =
             placed.iter().map(|x| self.project(*x)).map(|[u, v]| [u as f32, v as f32]).collect();
@@ -210,6 +257,67 @@ impl FaceFitter {
             errors_iod,
             stages,
         })
+    }
+
+    /// The residuals of parameters `p` whose landmarks, placed in the camera, are `placed`.
+    fn residuals(&self, placed: &[DVec3], p: &[f64], problem: &Problem) -> Vec<f64> {
+        let depth = placed.iter().map(|x| x.z).sum::<f64>() / placed.len() as f64;
+        let f = self.camera.intrinsic[0][0];
+        let unit = problem.unit;
+        let mut r = Vec::with_capacity(3 * NUM_LANDMARKS + self.columns.len() * 3 + 6);
+        for (x, d) in placed.iter().zip(problem.detected) {
+            let [u, v] = self.project(*x);
+            let e = [(u - d[0]) / unit, (v - d[1]) / unit];
+            let s = pseudo_huber_scale(e[0].hypot(e[1]), ROBUST_DELTA);
+            r.push(s * e[0]);
+            r.push(s * e[1]);
+            // MediaPipe's z: camera-ward negative, on x's pixel scale, about the face.
+            r.push(DEPTH_WEIGHT * (f * (x.z - depth) / depth - (d[2] - problem.mean_z)) / unit);
+        }
+        let (shape, expression) = p[6..].split_at(self.num_shape);
+        r.extend(shape.iter().map(|a| SHAPE_WEIGHT * a));
+        r.extend(expression.iter().map(|e| EXPRESSION_WEIGHT * e));
+        r.extend(expression.iter().map(|e| BOUND_WEIGHT * (e.min(0.0) + (e - 1.0).max(0.0))));
+        if let Some(prev) = problem.previous {
+            let turn = rotation_gap(prev.rotation, quat(p));
+            let shift = DVec3::new(p[3], p[4], p[5]) - prev.translation;
+            r.extend(turn.to_array().map(|c| ROTATION_SMOOTHING * c));
+            r.extend(shift.to_array().map(|c| TRANSLATION_SMOOTHING * c));
+            r.extend(
+                expression.iter().zip(&prev.expression).map(|(e, q)| EXPRESSION_SMOOTHING * (e - *q as f64)),
+            );
+        }
+        r
+    }
+
+    /// ∂r/∂p over `free` by central differences. A coefficient moves each landmark along its own
+    /// column, so its probes shift the placed points instead of rebuilding them from all
+    /// coefficients.
+    fn jacobian(&self, x: &[f64], free: &[usize], problem: &Problem) -> Vec<Vec<f64>> {
+        let placed = self.placed(x);
+        let r = quat(x);
+        let mut probe = x.to_vec();
+        let mut moved = placed.clone();
+        free.iter()
+            .map(|&i| {
+                let mut side = |sign: f64| {
+                    probe[i] = x[i] + sign * STEP;
+                    let out = match i.checked_sub(6) {
+                        None => self.residuals(&self.placed(&probe), &probe, problem),
+                        Some(k) => {
+                            for ((m, p), c) in moved.iter_mut().zip(&placed).zip(&self.columns[k]) {
+                                *m = *p + sign * STEP * (r * *c);
+                            }
+                            self.residuals(&moved, &probe, problem)
+                        }
+                    };
+                    probe[i] = x[i];
+                    out
+                };
+                let (plus, minus) = (side(1.0), side(-1.0));
+                plus.iter().zip(&minus).map(|(p, q)| (p - q) / (2.0 * STEP)).collect()
+            })
+            .collect()
     }
 
     /// The neutral face turned onto the mesh's 3D points (pixels, y down, z away: the camera's
@@ -243,7 +351,6 @@ fn quat(p: &[f64]) -> DQuat {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body_fit::rotation_gap;
     use crate::crop::RotatedRect;
 
     /// Landmarks a known face would give, drawn from the fit's own model: a check of the solver

@@ -1,5 +1,5 @@
 //! Levenberg–Marquardt on a residual vector, with central-difference Jacobians over the free
-//! parameters. The fits here have ~100 parameters and a few hundred residuals, so dense normal
+//! parameters (or a Jacobian the problem computes itself). The fits here have ~100 parameters and a few hundred residuals, so dense normal
 //! equations solved by Cholesky are the simple and fast choice.
 
 /// How a minimisation went.
@@ -24,6 +24,32 @@ pub fn minimise(
     iterations: usize,
     step: f64,
 ) -> Summary {
+    let central = |x: &[f64]| -> Vec<Vec<f64>> {
+        let mut probe = x.to_vec();
+        free.iter()
+            .map(|&i| {
+                probe[i] = x[i] + step;
+                let plus = f(&probe);
+                probe[i] = x[i] - step;
+                let minus = f(&probe);
+                probe[i] = x[i];
+                plus.iter().zip(&minus).map(|(p, q)| (p - q) / (2.0 * step)).collect()
+            })
+            .collect()
+    };
+    minimise_with(f, &central, x, free, iterations)
+}
+
+/// [`minimise`] with the Jacobian given: `jacobian(x)` returns ∂r/∂x_i for each free parameter
+/// i, in the order of `free` (a problem that knows which residuals a parameter moves can
+/// difference far fewer of them).
+pub fn minimise_with(
+    f: &dyn Fn(&[f64]) -> Vec<f64>,
+    jacobian: &dyn Fn(&[f64]) -> Vec<Vec<f64>>,
+    x: &mut [f64],
+    free: &[usize],
+    iterations: usize,
+) -> Summary {
     let mut r = f(x);
     let initial_cost = cost(&r);
     let mut current = initial_cost;
@@ -32,7 +58,7 @@ pub fn minimise(
     let n = free.len();
     while done < iterations {
         done += 1;
-        let jac = jacobian(f, x, free, step, r.len());
+        let jac = jacobian(x);
         let mut jtj = vec![0.0; n * n];
         let mut jtr = vec![0.0; n];
         for a in 0..n {
@@ -77,22 +103,6 @@ pub fn minimise(
         }
     }
     Summary { initial_cost, final_cost: current, iterations: done }
-}
-
-/// ∂r/∂x_i for each free parameter, by central differences.
-fn jacobian(f: &dyn Fn(&[f64]) -> Vec<f64>, x: &[f64], free: &[usize], step: f64, m: usize) -> Vec<Vec<f64>> {
-    let mut probe = x.to_vec();
-    free.iter()
-        .map(|&i| {
-            probe[i] = x[i] + step;
-            let plus = f(&probe);
-            probe[i] = x[i] - step;
-            let minus = f(&probe);
-            probe[i] = x[i];
-            debug_assert_eq!(plus.len(), m);
-            plus.iter().zip(&minus).map(|(p, q)| (p - q) / (2.0 * step)).collect()
-        })
-        .collect()
 }
 
 /// Solves M d = b for symmetric positive definite M (overwritten by its factor); None when M is
