@@ -450,6 +450,7 @@ def write_fixtures(out_dir):
         save(out_dir, f"pipeline_{image}.npz", **pipeline(picture(image)))
         save(out_dir, f"face_pipeline_{image}.npz", **face_pipeline(picture(image)))
         shutil.copyfile(picture_path(image), os.path.join(out_dir, f"{image}.png"))
+    save(out_dir, "face_track_astronaut.npz", **face_track(picture("astronaut")))
     write_provenance(out_dir)
 
 
@@ -520,6 +521,11 @@ def write_provenance(out_dir):
         "(x, z times the width, y times the height), `detection` [17] (score, xmin, ymin, width, "
         "height, then 6 keypoints x, y, relative to the image), `roi` [5] (the mesh crop made "
         "from that detection: x_center, y_center, width, height relative, rotation in radians).",
+        "- `face_track_astronaut.npz`: the same graph in video mode (`static_image_mode=False`, so "
+        "each crop after the first comes from the previous frame's landmarks) over 448² windows of "
+        "`astronaut.png` at `offsets` [8,2] (x, y of the window's corner): `landmarks_px` [8,468,3] "
+        "in the window's pixels (z times its width), `next_roi_px` [8,5] (the crop each frame's "
+        "landmarks make for the next: x_center, y_center, width, height in pixels, rotation).",
         "",
     ]
     with open(os.path.join(out_dir, "PROVENANCE.md"), "w") as f:
@@ -602,6 +608,39 @@ def face_pipeline(rgb):
     roi = r.face_rects_from_detections[0]
     out["roi"] = np.array([roi.x_center, roi.y_center, roi.width, roi.height, roi.rotation], np.float32)
     return out
+
+
+# A "video" of astronaut.png: 448² windows of it at these (x, y) offsets, so the face moves by
+# whole pixels from frame to frame.
+TRACK_WINDOW = 448
+TRACK_OFFSETS = [(32, 32), (40, 30), (48, 28), (56, 30), (60, 36), (52, 44), (40, 48), (30, 40)]
+
+
+def face_track(rgb):
+    """mp.solutions.face_mesh.FaceMesh(static_image_mode=False, max_num_faces=1,
+    refine_landmarks=False) over the windows: after the first frame each crop comes from the
+    previous frame's landmarks (MediaPipe's tracking)."""
+    from mediapipe.python.solution_base import SolutionBase
+    from mediapipe.python.solutions import face_mesh
+    solution = SolutionBase(
+        binary_graph_path=face_mesh._BINARYPB_FILE_PATH,
+        side_inputs={"num_faces": 1, "with_attention": False, "use_prev_landmarks": True},
+        calculator_params={
+            "facedetectionshortrangecpu__facedetectionshortrange__facedetection__TensorsToDetectionsCalculator.min_score_thresh": 0.5,
+            "facelandmarkcpu__ThresholdingCalculator.threshold": 0.5},
+        outputs=["multi_face_landmarks", "face_rects_from_landmarks"])
+    n = TRACK_WINDOW
+    landmarks, rois = [], []
+    with solution:
+        for x, y in TRACK_OFFSETS:
+            frame = np.ascontiguousarray(rgb[y:y + n, x:x + n])
+            r = solution.process({"image": frame})
+            lm = r.multi_face_landmarks[0].landmark
+            landmarks.append([[p.x * n, p.y * n, p.z * n] for p in lm])
+            roi = r.face_rects_from_landmarks[0]
+            rois.append([roi.x_center * n, roi.y_center * n, roi.width * n, roi.height * n, roi.rotation])
+    return {"offsets": np.array(TRACK_OFFSETS, np.float32), "window": np.array([n], np.float32),
+            "landmarks_px": np.array(landmarks, np.float32), "next_roi_px": np.array(rois, np.float32)}
 
 
 if __name__ == "__main__":

@@ -50,6 +50,27 @@ pub fn detection_roi(d: &Detection) -> RotatedRect {
     }
 }
 
+impl FaceLandmarks {
+    /// The next video frame's crop from these points (MediaPipe's
+    /// `face_landmark_landmarks_to_roi`): their bounding box, squared on its long side and grown
+    /// 1.5×, levelled by the outer eye corners (points 33 and 263).
+    pub fn next_roi(&self) -> RotatedRect {
+        let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
+        for p in &self.points {
+            (0..2).for_each(|c| (lo[c], hi[c]) = (lo[c].min(p[c]), hi[c].max(p[c])));
+        }
+        let side = ROI_SCALE * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        let eye = |i: usize| [self.points[i][0], self.points[i][1]];
+        RotatedRect {
+            cx: (lo[0] + hi[0]) / 2.0,
+            cy: (lo[1] + hi[1]) / 2.0,
+            width: side,
+            height: side,
+            rotation: level(eye(33), eye(263)),
+        }
+    }
+}
+
 /// Runs the face mesh network on `roi` of the image.
 pub fn estimate(network: &Network, image: &Image, roi: RotatedRect) -> Result<FaceLandmarks, FitError> {
     let out = network.run(crop(image, &roi, INPUT_SIZE, Border::Replicate))?;

@@ -3,6 +3,7 @@
 
 use mannequin_data::Image;
 
+use crate::crop::RotatedRect;
 use crate::error::FitError;
 use crate::face_landmarker::{FaceLandmarks, MIN_FACE_FLAG, detection_roi, estimate};
 use crate::network::Network;
@@ -43,5 +44,22 @@ impl FaceModels {
         }
         out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
         Ok(out)
+    }
+
+    /// A video frame's face mesh: read in `previous` (the last frame's next crop) while the
+    /// network still sees a face there, else from the largest face the detector finds (MediaPipe's
+    /// tracking); None when there is no face.
+    pub fn track(
+        &self,
+        image: &Image,
+        previous: Option<RotatedRect>,
+    ) -> Result<Option<FaceLandmarks>, FitError> {
+        if let Some(roi) = previous {
+            let landmarks = estimate(&self.landmarker, image, roi)?;
+            if landmarks.flag >= MIN_FACE_FLAG {
+                return Ok(Some(landmarks));
+            }
+        }
+        Ok(self.faces(image)?.into_iter().next().map(|f| f.landmarks))
     }
 }
