@@ -6,7 +6,8 @@
 //!
 //! - the landmarks' reprojection, robust (pseudo-Huber), in 1 % of the inter-ocular distance;
 //! - their relative depth against the mesh's z (weak perspective), at a third of that weight;
-//! - priors: α is unit normal, expressions are pulled to neutral and kept in [0, 1].
+//! - priors: α is unit normal, expressions are pulled to neutral and kept in [0, 1];
+//! - in a video, a pull toward the previous frame's fit.
 //!
 //! The camera is the body fit's (`picture_camera`): the focal length given or assumed. The fit
 //! starts from the neutral face turned and scaled onto the mesh's 3D points (Kabsch), at the
@@ -32,7 +33,11 @@ const UNIT: f64 = 0.01;
 const ROBUST_DELTA: f64 = 2.0;
 const DEPTH_WEIGHT: f64 = 0.3;
 const SHAPE_WEIGHT: f64 = 1.0;
-const EXPRESSION_WEIGHT: f64 = 0.3;
+/// Per unit of expression weight. The 52 units overlap (jawLeft with jawRight, the eyes' looks
+/// with their lids), and a weak pull lets them soak up where the generic head differs from the
+/// face: at 0.3 they wander by 0.2 between frames that differ by a 4-pixel shift, at 10 they
+/// hold, and the landmark error rises from 1.79 to 1.84 % on astronaut.png.
+const EXPRESSION_WEIGHT: f64 = 10.0;
 /// Per unit an expression weight strays out of [0, 1].
 const BOUND_WEIGHT: f64 = 30.0;
 /// A video frame's pull toward the previous frame's fit: per radian the head turns, per metre it
@@ -40,6 +45,9 @@ const BOUND_WEIGHT: f64 = 30.0;
 const ROTATION_SMOOTHING: f64 = 100.0;
 const TRANSLATION_SMOOTHING: f64 = 300.0;
 const EXPRESSION_SMOOTHING: f64 = 5.0;
+/// A video frame starts at the previous frame's fit and needs few steps: on a 30-frame clip of a
+/// moving portrait, 4 give the same landmark error as 10 (1.849 %) with expressions within 0.02.
+const TRACK_ITERATIONS: usize = 4;
 /// The finite differences' half-width.
 const STEP: f64 = 1e-5;
 
@@ -231,7 +239,9 @@ impl FaceFitter {
             move |x: &[f64]| self.jacobian(x, &free, problem)
         };
         let stages = match previous {
-            Some(_) => vec![minimise_with(&residuals, &jacobian(&free), &mut params, &free, 10)],
+            Some(_) => {
+                vec![minimise_with(&residuals, &jacobian(&free), &mut params, &free, TRACK_ITERATIONS)]
+            }
             None => vec![
                 minimise_with(&residuals, &jacobian(&placement), &mut params, &placement, 20),
                 minimise_with(&residuals, &jacobian(&free), &mut params, &free, 30),

@@ -172,7 +172,7 @@ struct Saved {
 }
 
 /// Decodes `video` into PNG frames under `out/.frames` with ffmpeg.
-fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
+pub(crate) fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
     if !video.is_file() {
         bail!("{}: no such video file", video.display());
     }
@@ -199,7 +199,7 @@ fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
 }
 
 /// The image files of a folder, in name order.
-fn frame_files(dir: &Path) -> Result<Vec<PathBuf>> {
+pub(crate) fn frame_files(dir: &Path) -> Result<Vec<PathBuf>> {
     let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
     let mut files: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))

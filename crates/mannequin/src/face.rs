@@ -22,7 +22,7 @@ use crate::fit::FitArgs;
 
 /// The face mesh reads a 192² crop 1.5× the face box: a box much under 48 pixels is upsampled
 /// past what the network saw in training.
-const MIN_FACE_PX: f32 = 48.0;
+pub(crate) const MIN_FACE_PX: f32 = 48.0;
 /// A vertex takes the photo's colour when its normal faces the camera at least this much.
 const FACING: f64 = 0.25;
 
@@ -31,6 +31,9 @@ pub enum FaceCommand {
     /// Fit the default body's face (shape, expression, head pose) to a portrait: face.obj with
     /// colours, face.glb with the 52 expressions as morph targets, overlay.png and fit.json.
     Fit(FaceFitArgs),
+    /// Follow the face through a video: shape fitted once, expression and head pose per frame;
+    /// face.glb with the expressions keyed per frame, overlay frames and track.json.
+    Track(crate::face_track::FaceTrackArgs),
 }
 
 #[derive(clap::Args)]
@@ -48,6 +51,7 @@ pub struct FaceFitArgs {
 pub fn run(command: FaceCommand) -> Result<()> {
     match command {
         FaceCommand::Fit(args) => fit(args),
+        FaceCommand::Track(args) => crate::face_track::track(args),
     }
 }
 
@@ -104,9 +108,8 @@ fn fit(args: FaceFitArgs) -> Result<()> {
     Ok(())
 }
 
-/// The default body's head with the fitted shape and expression, in the body's rest frame,
-/// coloured from the photo where it faces the camera and from its mirror image elsewhere.
-fn head_mesh(body: &BodyModel, face: &FaceModel, fitted: &FaceFit, image: &Image) -> Result<TriMesh> {
+/// The default body's head with the fitted shape and expression, in the body's rest frame.
+pub(crate) fn fitted_head(body: &BodyModel, face: &FaceModel, fitted: &FaceFit) -> Result<TriMesh> {
     let mut positions = body.v_template.clone();
     face.apply(&mut positions, &fitted.shape, &fitted.expression)?;
     let mut index = vec![None; positions.len()];
@@ -117,6 +120,18 @@ fn head_mesh(body: &BodyModel, face: &FaceModel, fitted: &FaceFit, image: &Image
         .filter_map(|f| Some([index[f[0] as usize]?, index[f[1] as usize]?, index[f[2] as usize]?]))
         .collect();
     let head: Vec<[f32; 3]> = face.vertices.iter().map(|&v| positions[v]).collect();
+    Ok(TriMesh::new(head, faces))
+}
+
+/// [`fitted_head`] coloured from the photo where it faces the camera and from its mirror image
+/// elsewhere.
+pub(crate) fn head_mesh(
+    body: &BodyModel,
+    face: &FaceModel,
+    fitted: &FaceFit,
+    image: &Image,
+) -> Result<TriMesh> {
+    let TriMesh { positions: head, faces, .. } = fitted_head(body, face, fitted)?;
     let normals = vertex_normals(&head, &faces);
     let seen: Vec<Option<[f32; 3]>> = head
         .iter()
@@ -161,7 +176,7 @@ fn head_mesh(body: &BodyModel, face: &FaceModel, fitted: &FaceFit, image: &Image
 /// The fitted head as blend shapes: the 52 expression units as named morph targets over the
 /// head without its expression, shown at the fitted weights (so a viewer shows the fitted face,
 /// and moving a weight animates it).
-fn expression_shapes(face: &FaceModel, head: &TriMesh, expression: &[f32]) -> BlendShapeMesh {
+pub(crate) fn expression_shapes(face: &FaceModel, head: &TriMesh, expression: &[f32]) -> BlendShapeMesh {
     let v = face.vertices.len();
     let shapes: Vec<Vec<[f32; 3]>> = (0..face.num_expressions())
         .map(|k| {
@@ -203,7 +218,7 @@ fn sample(image: &Image, u: f64, v: f64) -> Option<[f32; 3]> {
 }
 
 /// The head's edges that face the camera, projected: what the overlay draws.
-fn projected_edges(head: &TriMesh, fitted: &FaceFit) -> Vec<[[f32; 2]; 2]> {
+pub(crate) fn projected_edges(head: &TriMesh, fitted: &FaceFit) -> Vec<[[f32; 2]; 2]> {
     let mut edges = Vec::new();
     for f in &head.faces {
         let p: Vec<DVec3> = f.iter().map(|&v| fitted.to_camera(head.positions[v as usize])).collect();

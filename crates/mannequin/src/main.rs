@@ -12,6 +12,7 @@ mod dress;
 mod eval;
 mod export;
 mod face;
+mod face_track;
 mod fit;
 mod garment;
 mod motion;

@@ -111,3 +111,88 @@ fn pictures_without_a_fittable_face_are_refused_in_one_line() {
     );
     assert!(!out.exists(), "a refused fit writes nothing");
 }
+
+/// Ten 448² windows of astronaut.png, each 4 pixels right of the last: the face moves 4 pixels
+/// left per frame and nothing else changes.
+fn moving_window(dir: &Path) -> std::path::PathBuf {
+    let photo = Image::read(&picture("astronaut.png")).unwrap();
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    for k in 0..10 {
+        let x0 = 20 + 4 * k;
+        let pixels = (0..448)
+            .flat_map(|y| (0..448).map(move |x| (x, y)))
+            .map(|(x, y)| photo.at(x0 + x, 32 + y))
+            .collect();
+        Image { width: 448, height: 448, pixels }.write_png(&frames.join(format!("{k:02}.png"))).unwrap();
+    }
+    frames
+}
+
+#[test]
+fn a_video_is_tracked_frame_by_frame() {
+    let dir = scratch("face_track");
+    let out = dir.join("track");
+    ok(mannequin(&["face", "track", "--frames", s(&moving_window(&dir)), "--out", s(&out)]));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("track.json")).unwrap()).unwrap();
+    assert_eq!(report["frames_with_face"], 10);
+    let frames = report["frames"].as_array().unwrap();
+    let errors: Vec<f64> = frames.iter().map(|f| f["landmark_error_iod"].as_f64().unwrap()).collect();
+    assert!(errors.iter().all(|e| *e < 0.03), "landmark errors {errors:?}");
+    // Pinhole: 36 pixels at depth z through the default focal length (the long side, 448 px).
+    let t = |k: usize| -> Vec<f64> {
+        frames[k]["head_translation_m"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    let (first, last) = (t(0), t(9));
+    let want = -36.0 * first[2] / 448.0;
+    let got = last[0] - first[0];
+    println!("the head moved {got:.4} m across; the window says {want:.4}");
+    assert!((got - want).abs() < 0.15 * want.abs(), "moved {got} m, expected {want}");
+    // The same face in every frame: its expression barely changes from frame to frame.
+    let expression = |k: usize| -> Vec<f64> {
+        frames[k]["expression"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    let jump = (1..10)
+        .map(|k| expression(k).iter().zip(expression(k - 1)).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    assert!(jump < 0.1, "an expression weight jumps by {jump} between frames");
+    for k in 0..10 {
+        assert!(out.join(format!("overlay/frame_{k:04}.png")).is_file(), "overlay of frame {k}");
+    }
+    let bytes = std::fs::read(out.join("face.glb")).unwrap();
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let doc: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let animation = &doc["animations"][0];
+    let paths: Vec<&str> = animation["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["target"]["path"].as_str().unwrap())
+        .collect();
+    assert_eq!(paths, ["weights", "rotation", "translation"]);
+    let keys = &doc["accessors"][animation["samplers"][0]["input"].as_u64().unwrap() as usize];
+    assert_eq!(keys["count"], 10, "one key per frame");
+    assert_eq!(doc["meshes"][0]["extras"]["targetNames"].as_array().unwrap().len(), 52);
+}
+
+#[test]
+fn a_video_without_a_face_is_refused_in_one_line() {
+    let dir = scratch("face_track_refusal");
+    let camera = Image::read(&picture("camera.png")).unwrap();
+    let frames = dir.join("sky");
+    std::fs::create_dir_all(&frames).unwrap();
+    for k in 0..3 {
+        let pixels = (0..200)
+            .flat_map(|y| (300..500).map(move |x| (x, y)))
+            .map(|(x, y)| camera.at(x, y + k))
+            .collect();
+        Image { width: 200, height: 200, pixels }.write_png(&frames.join(format!("{k}.png"))).unwrap();
+    }
+    let out = dir.join("out");
+    one_line_error(
+        &mannequin(&["face", "track", "--frames", s(&frames), "--out", s(&out)]),
+        &["sky", "no face found in any of its 3 frames"],
+    );
+    assert!(!out.exists(), "a refused track writes nothing");
+}
