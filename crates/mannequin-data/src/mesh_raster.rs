@@ -29,6 +29,8 @@ pub enum Shading<'a> {
     Texture { uv: &'a UvLayout, texture: &'a Image },
     /// One colour everywhere.
     Flat([f32; 3]),
+    /// A colour per vertex, interpolated by the (perspective-correct) barycentrics.
+    Vertex(&'a [[f32; 3]]),
 }
 
 /// A triangle mesh in world coordinates, with per-vertex normals used for shading normals.
@@ -209,6 +211,9 @@ pub fn rasterize(mesh: &RasterMesh, camera: &Camera, background: [f32; 3]) -> Ra
                 face_id[i] = f;
                 color[i] = match mesh.shading {
                     Shading::Flat(c) => c,
+                    Shading::Vertex(colours) => std::array::from_fn(|c| {
+                        (0..3).map(|k| colours[corners[k] as usize][c] * b[k]).sum::<f32>()
+                    }),
                     Shading::Texture { uv, texture } => {
                         let t = uv.faces[f as usize];
                         let st: Vec2 = (0..3).map(|k| Vec2::from(uv.coords[t[k] as usize]) * b[k]).sum();

@@ -236,3 +236,41 @@ fn bilinear_sampling_interpolates_between_texel_centres() {
     // Clamped outside.
     assert_eq!(sample_bilinear(&tex, glam::Vec2::new(-1.0, 2.0)), [0.0; 3]);
 }
+
+/// Vertex colours on the tilted quad: red = s and green = t at the corners (s, t) of
+/// o + s a + t b, so each pixel's colour is where its ray meets the plane, in closed form.
+#[test]
+fn vertex_colours_interpolate_perspective_correctly() {
+    let cam = camera(64, 56);
+    let o = DVec3::new(-0.5, 0.3, 2.0);
+    let a = DVec3::new(1.0, 0.0, 0.8);
+    let b = DVec3::new(0.1, -0.7, 0.3);
+    let corners = [o, o + a, o + a + b, o + b].map(|p| p.as_vec3().to_array());
+    let colours = [[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [1.0, 1.0, 0.5], [0.0, 1.0, 0.5]];
+    let faces = [[0, 1, 2], [0, 2, 3]];
+    let normal = a.cross(b).normalize().as_vec3().to_array();
+    let mesh = RasterMesh {
+        positions: &corners,
+        faces: &faces,
+        normals: &[normal; 4],
+        shading: Shading::Vertex(&colours),
+    };
+    let out = rasterize(&mesh, &cam, [0.0; 3]);
+    let mut covered = 0;
+    for y in 0..cam.height {
+        for x in 0..cam.width {
+            if out.face_id[y * cam.width + x] == NO_FACE {
+                continue;
+            }
+            covered += 1;
+            let (s, t, _) = ray_plane(&cam, x, y, o, a, b);
+            let got = out.color.at(x, y);
+            assert!(
+                (got[0] - s as f32).abs() < 1e-4 && (got[1] - t as f32).abs() < 1e-4,
+                "({x}, {y}): {got:?} vs ({s}, {t})"
+            );
+            assert!((got[2] - 0.5).abs() < 1e-6);
+        }
+    }
+    assert!(covered > 300, "{covered} pixels covered");
+}
