@@ -245,6 +245,7 @@ fn report(face: &Face, fitted: &FaceFit, seconds: f64) -> serde_json::Value {
             "per_landmark": fitted.errors_iod,
         },
         "inter_ocular_px": (a[0] - b[0]).hypot(a[1] - b[1]),
+        "landmarks_px": face.landmarks.points,
         "face_box": face.detection.bbox,
         "detection_score": face.detection.score,
         "shape": fitted.shape,

@@ -1,16 +1,19 @@
 //! `mannequin fit --image photo.jpg --out DIR`: finds the person in a photo, reads their
 //! landmarks and mask with the shipped person models, and fits the body to them (thesis §2.2.2).
 //! Writes the body in SMPL's layout with its camera, as meshes, an overlay to check it by, and
-//! the fit's numbers.
+//! the fit's numbers. On the default body the person's face is fitted too (`face fit`), and the
+//! body carries the fitted head.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use mannequin_body::{BodyModel, forward, skeletal_animation, skinned_body};
+use mannequin_body::{BodyModel, FaceModel, forward, skeletal_animation, skinned_body};
 use mannequin_data::Image;
 use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_fit::FaceModels;
 use mannequin_fit::body_fit::assumed_focal;
+use mannequin_fit::face_fit::{FaceFit, FaceFitter};
 use mannequin_fit::overlay::overlay;
 use mannequin_fit::pose_landmarker::PoseLandmarks;
 use mannequin_fit::{BodyFit, Person, PersonModels, fit_body, pick_person};
@@ -18,6 +21,7 @@ use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
 
 use crate::body::load_body;
+use crate::face::MIN_FACE_PX;
 
 /// The detector reads a 224² letterbox: smaller pictures hold too little to find a body in.
 const MIN_SIDE: usize = 128;
@@ -32,6 +36,10 @@ pub struct Args {
     person: Option<usize>,
     #[command(flatten)]
     fitting: FitArgs,
+    /// Do not fit the face (by default the default body's face is fitted too when the face is
+    /// at least 48 pixels across, adding about half a second).
+    #[arg(long)]
+    no_face: bool,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -83,14 +91,24 @@ pub fn run(args: Args) -> Result<()> {
     let focal = args.fitting.focal(image.width, image.height);
     let fit = fit_body(&model, &landmarks, image.width, image.height, focal)
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
+    let head = match args.no_face || args.fitting.body != "default" {
+        true => Head::NotAsked,
+        false => fit_head(&image, &landmarks, focal)
+            .with_context(|| format!("fitting the face in {}", args.image.display()))?,
+    };
+    let model = match &head {
+        Head::Fitted(face) => with_head(model, face)?,
+        _ => model,
+    };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let mesh = posed_mesh(&model, &fit)?;
     let (picture, iou) = check_picture(&image, &mesh, &landmarks, &fit);
-    write_body_npz(&args.out.join("body.npz"), &fit)?;
+    write_body_npz(&args.out.join("body.npz"), &fit, &head)?;
     crate::body::write_mesh(&args.out.join("body.obj"), &mesh)?;
     write_glb(&args.out.join("body.glb"), &model, &fit)?;
     picture.write_png(&args.out.join("overlay.png"))?;
-    let report = report(&fit, person, iou, focal, start.elapsed().as_secs_f64());
+    let mut report = report(&fit, person, iou, focal, start.elapsed().as_secs_f64());
+    report["face"] = head.report();
     mannequin_io::write_atomic(&args.out.join("fit.json"), serde_json::to_string_pretty(&report)?.as_bytes())
         .with_context(|| format!("writing {}", args.out.join("fit.json").display()))?;
     tracing::info!(
@@ -102,6 +120,65 @@ pub fn run(args: Args) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Whether the body carries the person's fitted face.
+enum Head {
+    Fitted(FaceFit),
+    /// Why not: no face at the person's head, or one too small.
+    Skipped(String),
+    /// `--no-face`, or a body the face model is not made for.
+    NotAsked,
+}
+
+impl Head {
+    fn report(&self) -> serde_json::Value {
+        match self {
+            Head::Fitted(f) => serde_json::json!({
+                "fitted": true,
+                "landmark_error_iod": f.mean_error_iod(),
+                "shape": f.shape,
+                "expression": f.expression,
+            }),
+            Head::Skipped(why) => serde_json::json!({ "fitted": false, "why": why }),
+            Head::NotAsked => {
+                serde_json::json!({ "fitted": false, "why": "not asked (--no-face or a body other than the default)" })
+            }
+        }
+    }
+}
+
+/// The face (thesis §2.3) of the person whose body was fitted: the largest face whose box holds
+/// the body's nose landmark, when it is large enough to fit.
+fn fit_head(image: &Image, landmarks: &PoseLandmarks, focal: f64) -> Result<Head> {
+    let nose = landmarks.points[0];
+    let faces = FaceModels::load()?.faces(image)?;
+    let Some(face) = faces.into_iter().find(|f| {
+        let [x0, y0, x1, y1] = f.detection.bbox;
+        (x0..=x1).contains(&nose[0]) && (y0..=y1).contains(&nose[1])
+    }) else {
+        return Ok(Head::Skipped("no face found at the person's head".into()));
+    };
+    let [x0, y0, x1, y1] = face.detection.bbox;
+    let side = (x1 - x0).max(y1 - y0);
+    if side < MIN_FACE_PX {
+        return Ok(Head::Skipped(format!("the face is {side:.0} pixels across, under {MIN_FACE_PX}")));
+    }
+    let fitter = FaceFitter::new(
+        &BodyModel::default_body(),
+        &FaceModel::default_face(),
+        image.width,
+        image.height,
+        focal,
+    )?;
+    Ok(Head::Fitted(fitter.fit(&face.landmarks)?))
+}
+
+/// The default body with the fitted face's shape and expression on its head: every output
+/// (meshes, skinned glTF) then carries the head.
+fn with_head(mut model: BodyModel, face: &FaceFit) -> Result<BodyModel> {
+    FaceModel::default_face().apply(&mut model.v_template, &face.shape, &face.expression)?;
+    Ok(model)
 }
 
 /// The overlay a user checks a fit by (`mannequin_fit::overlay`), and the IoU of the body's
@@ -138,7 +215,7 @@ fn render(mesh: &TriMesh, fit: &BodyFit) -> mannequin_data::mesh_raster::Raster 
 
 /// SMPL's layout as PeopleSnapshot's pose files have it (one frame), plus the camera as its
 /// `cameras.npz` has it.
-fn write_body_npz(path: &Path, fit: &BodyFit) -> Result<()> {
+fn write_body_npz(path: &Path, fit: &BodyFit, head: &Head) -> Result<()> {
     let c = &fit.camera;
     let mut w = NpzWriter::new();
     w.add("betas", NpyArray::f32(vec![1, fit.betas.len()], fit.betas.clone()))
@@ -149,6 +226,11 @@ fn write_body_npz(path: &Path, fit: &BodyFit) -> Result<()> {
         .add("extrinsic", NpyArray::f64(vec![4, 4], c.extrinsic.iter().flatten().copied().collect()))
         .add("height", NpyArray::i64(vec![], vec![c.height as i64]))
         .add("width", NpyArray::i64(vec![], vec![c.width as i64]));
+    if let Head::Fitted(face) = head {
+        // The default body's face model coefficients (`mannequin_body::FaceModel`).
+        w.add("face_shape", NpyArray::f32(vec![1, face.shape.len()], face.shape.clone()))
+            .add("face_expression", NpyArray::f32(vec![1, face.expression.len()], face.expression.clone()));
+    }
     w.write(path).with_context(|| format!("writing {}", path.display()))
 }
 

@@ -38,6 +38,40 @@ fn a_photo_gets_a_body_that_explains_its_landmarks() {
     KHRONOS_VALIDATOR.run(&out.join("body.glb"));
     let overlay = mannequin_data::Image::read(&out.join("overlay.png")).unwrap();
     assert_eq!((overlay.width, overlay.height), (512, 512));
+    the_body_carries_the_fitted_head(&out, &report, &mesh);
+}
+
+/// The face is fitted too, and the head is what differs from the same fit with `--no-face`.
+fn the_body_carries_the_fitted_head(out: &Path, report: &serde_json::Value, mesh: &mannequin_mesh::TriMesh) {
+    assert_eq!(report["face"]["fitted"], true, "{}", report["face"]);
+    let error = report["face"]["landmark_error_iod"].as_f64().unwrap();
+    // camera.png's face is a profile behind a camera (measured 5.0 %).
+    assert!(error < 0.08, "face landmark error {error} of the eyes' distance");
+    let npz = mannequin_io::Npz::read(out.join("body.npz")).unwrap();
+    assert_eq!(npz.require("face_shape").unwrap().shape, [1, 63]);
+    assert_eq!(npz.require("face_expression").unwrap().shape, [1, 52]);
+    let bare = out.with_extension("no-face");
+    ok(mannequin(&["fit", "--image", s(&picture("camera.png")), "--no-face", "--out", s(&bare)]));
+    let no_face: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(bare.join("fit.json")).unwrap()).unwrap();
+    assert_eq!(no_face["face"]["fitted"], false);
+    assert!(mannequin_io::Npz::read(bare.join("body.npz")).unwrap().get("face_shape").is_none());
+    let plain = mannequin_mesh::read_obj(bare.join("body.obj")).unwrap();
+    let head: std::collections::HashSet<usize> =
+        mannequin_body::FaceModel::default_face().vertices.into_iter().collect();
+    let (mut head_move, mut body_move) = (0.0f32, 0.0f32);
+    for (i, (a, b)) in mesh.positions.iter().zip(&plain.positions).enumerate() {
+        let d = (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f32>().sqrt();
+        match head.contains(&i) {
+            true => head_move = head_move.max(d),
+            false => body_move = body_move.max(d),
+        }
+    }
+    println!("the fitted face moves the head by up to {head_move} m, the rest by {body_move} m");
+    assert!(head_move > 0.002, "the head moved by {head_move} m");
+    // The joints are regressed from the shaped vertices, head included, so the neck and head
+    // joints shift a little with the face, and what they carry with them (measured 0.8 mm).
+    assert!(body_move < 0.002 && body_move < head_move / 5.0, "the rest of the body moved by {body_move} m");
 }
 
 #[test]
