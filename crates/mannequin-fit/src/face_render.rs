@@ -1,6 +1,6 @@
 //! A coloured head drawn as a picture a face fit could be given: the rasteriser's vertex colours
 //! lit by one directional light and an ambient term. Used to measure the fit on faces whose
-//! truth is known and to find where the face mesh network puts its points on the default head.
+//! truth is known.
 
 use glam::{DVec3, Vec3};
 use mannequin_data::mesh_raster::{Raster, RasterMesh, Shading, rasterize};
