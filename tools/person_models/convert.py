@@ -468,6 +468,20 @@ PICTURE_NOTES = {
 }
 
 
+# A third portrait, for the face fit only (no fixture is made from it).
+GRACE_HOPPER = [
+    "## `grace_hopper.jpg`",
+    "",
+    "Copied unchanged from matplotlib 3.11.2 (PyPI wheel), "
+    "`matplotlib/mpl-data/sample_data/grace_hopper.jpg`, sha256 "
+    "`a8ca6d734765703b09728ab47fe59f473d93ae3967fc24c7c0288c3c7adb7130`: the official US Navy "
+    "portrait of Commodore Grace M. Hopper, a work of the US federal government and so in the "
+    "public domain (Wikimedia Commons lists it as \"Commodore Grace M. Hopper, USN (covered)\"). "
+    "512 × 600, JPEG.",
+    "",
+]
+
+
 def write_provenance(out_dir):
     import skimage
     import skimage.data
@@ -483,7 +497,7 @@ def write_provenance(out_dir):
             f"`skimage.data.{image}` says:",
             "",
         ] + [f"> {q}" for q in quotes] + [""]
-    lines += [
+    lines += GRACE_HOPPER + [
         "## Fixtures",
         "",
         "Made by `tools/person_models/convert.py fixtures` (see its docstring) from the original "

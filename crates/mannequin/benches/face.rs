@@ -5,7 +5,8 @@
 //!   astronaut.png, then fitted by `mannequin face fit`. Scored in the head's rest frame: the
 //!   mean per-vertex error (mm) over the face (head vertices within 10 mm of a landmark's
 //!   point), against the neutral default head as a baseline; and the landmark error.
-//! - **Real:** the committed portraits' landmark error over the inter-ocular distance.
+//! - **Real:** the committed portraits' landmark error over the inter-ocular distance (camera.png
+//!   is a profile behind a camera, past what the 3 % is asked of).
 //! - **Speed:** one image (the fit's own time), and `face track` on a rendered clip (frames per
 //!   second, and the per-vertex error through it).
 //!
@@ -229,11 +230,11 @@ fn main() {
         let seconds = report["seconds"].as_f64().unwrap();
         one_image.push(seconds);
         println!(
-            "| {name}.png | {:.2} % | {seconds:.2} s |",
+            "| {name} | {:.2} % | {seconds:.2} s |",
             100.0 * report["landmark_error_iod"]["mean"].as_f64().unwrap()
         );
     }
-    let albedo = read_obj(dir.join("astronaut/face.obj")).unwrap().colors.expect("face.obj has colours");
+    let albedo = read_obj(dir.join("astronaut.png/face.obj")).unwrap().colors.expect("face.obj has colours");
     let scene = Scene::new(albedo);
     let neutral = scene.head(&[], &[]);
 

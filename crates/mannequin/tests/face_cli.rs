@@ -1,6 +1,7 @@
-//! `mannequin face fit` as a user runs it, on the public-domain portrait `astronaut.png`: the
-//! face model fitted to MediaPipe's face mesh within the 3 % of the eyes' distance, and
-//! the pictures it cannot fit refused in one line with nothing written.
+//! `mannequin face fit` and `face track` as a user runs them, on the public-domain portraits
+//! `astronaut.png` and `grace_hopper.jpg`: the face model fitted to MediaPipe's face mesh within
+//! the 3 % of the eyes' distance, a moving window of a portrait tracked, and the pictures
+//! it cannot fit refused in one line with nothing written.
 
 use std::path::Path;
 
@@ -15,16 +16,29 @@ fn picture(name: &str) -> std::path::PathBuf {
 #[test]
 fn a_portrait_gets_its_face_fitted_within_three_percent_of_the_eyes_distance() {
     let dir = scratch("face_fit");
-    let out = dir.join("astronaut");
-    ok(mannequin(&["face", "fit", "--image", s(&picture("astronaut.png")), "--out", s(&out)]));
+    // Grace Hopper's portrait is a JPEG; measured 2.57 % (astronaut) and 2.55 % (grace_hopper).
+    for name in ["grace_hopper.jpg", "astronaut.png"] {
+        let out = dir.join(name);
+        ok(mannequin(&["face", "fit", "--image", s(&picture(name)), "--out", s(&out)]));
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("fit.json")).unwrap()).unwrap();
+        let mean = report["landmark_error_iod"]["mean"].as_f64().unwrap();
+        println!("{name}: mean landmark error {:.2} % of the eyes' distance", 100.0 * mean);
+        assert!(mean < 0.03, "{name}: mean landmark error {mean} of the inter-ocular distance");
+    }
+    let out = dir.join("astronaut.png");
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("fit.json")).unwrap()).unwrap();
-    let mean = report["landmark_error_iod"]["mean"].as_f64().unwrap();
-    println!("astronaut: mean landmark error {:.2} % of the eyes' distance", 100.0 * mean);
-    assert!(mean < 0.03, "mean landmark error {mean} of the inter-ocular distance");
     let expression = report["expression"].as_array().unwrap();
     assert_eq!(expression.len(), 52);
     assert!(expression.iter().all(|e| (-0.1..=1.1).contains(&e.as_f64().unwrap())), "{expression:?}");
+    // She smiles with her lips apart: the smile and the lips' units are among the strongest.
+    let names = mannequin_body::FaceModel::default_face().expression_names;
+    let mut ranked: Vec<(f64, &str)> =
+        expression.iter().map(|e| e.as_f64().unwrap()).zip(names.iter().map(String::as_str)).collect();
+    ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let top: Vec<&str> = ranked[..8].iter().map(|r| r.1).collect();
+    assert!(top.contains(&"mouthSmileLeft") && top.contains(&"mouthSmileRight"), "strongest units {top:?}");
     let overlay = Image::read(&out.join("overlay.png")).unwrap();
     assert_eq!((overlay.width, overlay.height), (512, 512));
     let text = std::fs::read_to_string(out.join("face.obj")).unwrap();
