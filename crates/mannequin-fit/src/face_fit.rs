@@ -73,6 +73,8 @@ pub struct FaceFit {
     pub expression: Vec<f32>,
     /// Camera from head: x_cam = R (x − centre) + t, with x on the default body's rest head.
     pub rotation: DQuat,
+    /// R as the solver holds it (a rotation vector): a video's next frame starts from it.
+    pub rotation_vector: DVec3,
     pub translation: DVec3,
     pub centre: DVec3,
     pub camera: Camera,
@@ -204,24 +206,12 @@ impl FaceFitter {
         shape: Option<&[f32]>,
         previous: Option<&FaceFit>,
     ) -> Result<FaceFit, FitError> {
-        if face.points.len() != NUM_LANDMARKS {
-            return Err(FitError::input(
-                "face landmarks",
-                format!("{} given, expected {NUM_LANDMARKS}", face.points.len()),
-            ));
-        }
-        let detected: Vec<[f64; 3]> =
-            face.points.iter().map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect();
-        let [a, b] = OUTER_EYE_CORNERS.map(|i| detected[i]);
-        let iod = (a[0] - b[0]).hypot(a[1] - b[1]);
-        if iod.is_nan() || iod <= 1.0 {
-            return Err(FitError::Picture("the face's eyes are less than a pixel apart".into()));
-        }
+        let (detected, iod) = detected(face)?;
         let mean_z = detected.iter().map(|p| p[2]).sum::<f64>() / detected.len() as f64;
         let mut params = vec![0.0; 6 + self.columns.len()];
         match previous {
             Some(prev) => {
-                params[..3].copy_from_slice(&prev.rotation.to_scaled_axis().to_array());
+                params[..3].copy_from_slice(&prev.rotation_vector.to_array());
                 params[3..6].copy_from_slice(&prev.translation.to_array());
                 let coefficients = prev.shape.iter().chain(&prev.expression);
                 params[6..].iter_mut().zip(coefficients).for_each(|(p, &c)| *p = c as f64);
@@ -253,26 +243,60 @@ impl FaceFitter {
                 minimise_with(&residuals, &jacobian(&free), &mut params, &free, 30),
             ],
         };
-        let placed = self.placed(&params);
+        Ok(self.outcome(&params, &detected, iod, stages))
+    }
+
+    /// The fit of stored parameters to `face`'s landmarks, without solving (a video's frame
+    /// fitted before a resume).
+    pub fn at(
+        &self,
+        face: &FaceLandmarks,
+        shape: &[f32],
+        expression: &[f32],
+        rotation_vector: DVec3,
+        translation: DVec3,
+    ) -> Result<FaceFit, FitError> {
+        let (detected, iod) = detected(face)?;
+        if shape.len() != self.num_shape || self.num_shape + expression.len() != self.columns.len() {
+            return Err(FitError::input(
+                "face fit",
+                format!(
+                    "{} shape and {} expression coefficients; the model has {} and {}",
+                    shape.len(),
+                    expression.len(),
+                    self.num_shape,
+                    self.columns.len() - self.num_shape
+                ),
+            ));
+        }
+        let mut params: Vec<f64> =
+            rotation_vector.to_array().into_iter().chain(translation.to_array()).collect();
+        params.extend(shape.iter().chain(expression).map(|&c| c as f64));
+        Ok(self.outcome(&params, &detected, iod, Vec::new()))
+    }
+
+    fn outcome(&self, params: &[f64], detected: &[[f64; 3]], iod: f64, stages: Vec<Summary>) -> FaceFit {
+        let placed = self.placed(params);
         let reprojected: Vec<[f32; 2]> =
             placed.iter().map(|x| self.project(*x)).map(|[u, v]| [u as f32, v as f32]).collect();
         let errors_iod = reprojected
             .iter()
-            .zip(&detected)
+            .zip(detected)
             .map(|(r, d)| ((r[0] as f64 - d[0]).hypot(r[1] as f64 - d[1]) / iod) as f32)
             .collect();
         let (shape, expression) = params[6..].split_at(self.num_shape);
-        Ok(FaceFit {
+        FaceFit {
             shape: shape.iter().map(|&v| v as f32).collect(),
             expression: expression.iter().map(|&v| v as f32).collect(),
-            rotation: quat(&params),
+            rotation: quat(params),
+            rotation_vector: DVec3::new(params[0], params[1], params[2]),
             translation: DVec3::new(params[3], params[4], params[5]),
             centre: self.centre,
             camera: self.camera.clone(),
             reprojected,
             errors_iod,
             stages,
-        })
+        }
     }
 
     /// The residuals of parameters `p` whose landmarks, placed in the camera, are `placed`.
@@ -357,6 +381,24 @@ impl FaceFitter {
         params[3..6].copy_from_slice(&t.to_array());
         Ok(())
     }
+}
+
+/// A face's landmarks in f64 and its inter-ocular distance, checked.
+fn detected(face: &FaceLandmarks) -> Result<(Vec<[f64; 3]>, f64), FitError> {
+    if face.points.len() != NUM_LANDMARKS {
+        return Err(FitError::input(
+            "face landmarks",
+            format!("{} given, expected {NUM_LANDMARKS}", face.points.len()),
+        ));
+    }
+    let detected: Vec<[f64; 3]> =
+        face.points.iter().map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect();
+    let [a, b] = OUTER_EYE_CORNERS.map(|i| detected[i]);
+    let iod = (a[0] - b[0]).hypot(a[1] - b[1]);
+    if iod.is_nan() || iod <= 1.0 {
+        return Err(FitError::Picture("the face's eyes are less than a pixel apart".into()));
+    }
+    Ok((detected, iod))
 }
 
 /// The head's rotation: the parameters' first three, a rotation vector.

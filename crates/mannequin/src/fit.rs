@@ -124,7 +124,7 @@ pub fn run(args: Args) -> Result<()> {
 
 /// Whether the body carries the person's fitted face.
 enum Head {
-    Fitted(FaceFit),
+    Fitted(Box<FaceFit>),
     /// Why not: no face at the person's head, or one too small.
     Skipped(String),
     /// `--no-face`, or a body the face model is not made for.
@@ -171,7 +171,7 @@ fn fit_head(image: &Image, landmarks: &PoseLandmarks, focal: f64) -> Result<Head
         image.height,
         focal,
     )?;
-    Ok(Head::Fitted(fitter.fit(&face.landmarks)?))
+    Ok(Head::Fitted(Box::new(fitter.fit(&face.landmarks)?)))
 }
 
 /// The default body with the fitted face's shape and expression on its head: every output

@@ -126,14 +126,14 @@ fn pictures_without_a_fittable_face_are_refused_in_one_line() {
     assert!(!out.exists(), "a refused fit writes nothing");
 }
 
-/// Ten 448² windows of astronaut.png, each 4 pixels right of the last: the face moves 4 pixels
-/// left per frame and nothing else changes.
-fn moving_window(dir: &Path) -> std::path::PathBuf {
+/// `count` 448² windows of astronaut.png, each `step` pixels right of the last: the face moves
+/// left by that per frame and nothing else changes.
+fn moving_window(dir: &Path, count: usize, step: f64) -> std::path::PathBuf {
     let photo = Image::read(&picture("astronaut.png")).unwrap();
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames).unwrap();
-    for k in 0..10 {
-        let x0 = 20 + 4 * k;
+    for k in 0..count {
+        let x0 = 20 + (step * k as f64) as usize;
         let pixels = (0..448)
             .flat_map(|y| (0..448).map(move |x| (x, y)))
             .map(|(x, y)| photo.at(x0 + x, 32 + y))
@@ -147,7 +147,8 @@ fn moving_window(dir: &Path) -> std::path::PathBuf {
 fn a_video_is_tracked_frame_by_frame() {
     let dir = scratch("face_track");
     let out = dir.join("track");
-    ok(mannequin(&["face", "track", "--frames", s(&moving_window(&dir)), "--out", s(&out)]));
+    ok(mannequin(&["face", "track", "--frames", s(&moving_window(&dir, 10, 4.0)), "--out", s(&out)]));
+    assert!(!out.join("checkpoint.npz").exists(), "a finished track leaves no checkpoint");
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("track.json")).unwrap()).unwrap();
     assert_eq!(report["frames_with_face"], 10);
@@ -209,4 +210,41 @@ fn a_video_without_a_face_is_refused_in_one_line() {
         &["sky", "no face found in any of its 3 frames"],
     );
     assert!(!out.exists(), "a refused track writes nothing");
+}
+
+/// A track killed once its first checkpoint is written resumes from it and ends with what an
+/// uninterrupted track writes; a checkpoint of other settings is refused, naming them.
+#[test]
+fn a_killed_track_resumes_to_the_same_result() {
+    let dir = scratch("face_track_resume");
+    let frames = moving_window(&dir, 60, 0.5);
+    let whole = dir.join("whole");
+    ok(mannequin(&["face", "track", "--frames", s(&frames), "--out", s(&whole)]));
+    let cut = dir.join("cut");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"))
+        .args(["face", "track", "--frames", s(&frames), "--out", s(&cut)])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let checkpoint = cut.join("checkpoint.npz");
+    while !checkpoint.exists() {
+        assert!(child.try_wait().unwrap().is_none(), "the track ended before writing a checkpoint");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!cut.join("track.json").exists(), "the track finished before it was killed");
+    one_line_error(
+        &mannequin(&["face", "track", "--frames", s(&frames), "--out", s(&cut), "--focal", "500"]),
+        &["checkpoint.npz", "another run", "focal", "--restart"],
+    );
+    let resumed = ok(mannequin(&["face", "track", "--frames", s(&frames), "--out", s(&cut)]));
+    assert!(String::from_utf8_lossy(&resumed.stderr).contains("resuming"));
+    let frames_of = |dir: &Path| -> serde_json::Value {
+        serde_json::from_slice::<serde_json::Value>(&std::fs::read(dir.join("track.json")).unwrap()).unwrap()
+            ["frames"]
+            .clone()
+    };
+    assert_eq!(frames_of(&whole), frames_of(&cut), "per-frame fits after the resume");
+    assert_eq!(std::fs::read(whole.join("face.glb")).unwrap(), std::fs::read(cut.join("face.glb")).unwrap());
 }
