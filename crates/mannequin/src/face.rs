@@ -87,7 +87,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
     let fitted = fitter
         .fit(&face.landmarks)
         .with_context(|| format!("fitting the face in {}", args.image.display()))?;
-    let head = head_mesh(&body, &face_model, &fitted, &image)?;
+    let head = head_mesh(&body, &face_model, &[(&fitted, &image)])?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     crate::body::write_mesh(&args.out.join("face.obj"), &head)?;
     let shapes = expression_shapes(&face_model, &head, &fitted.expression);
@@ -123,29 +123,31 @@ pub(crate) fn fitted_head(body: &BodyModel, face: &FaceModel, fitted: &FaceFit) 
     Ok(TriMesh::new(head, faces))
 }
 
-/// [`fitted_head`] coloured from the photo where it faces the camera and from its mirror image
-/// elsewhere.
-pub(crate) fn head_mesh(
-    body: &BodyModel,
-    face: &FaceModel,
-    fitted: &FaceFit,
-    image: &Image,
-) -> Result<TriMesh> {
-    let TriMesh { positions: head, faces, .. } = fitted_head(body, face, fitted)?;
-    let normals = vertex_normals(&head, &faces);
-    let seen: Vec<Option<[f32; 3]>> = head
-        .iter()
-        .zip(&normals)
-        .map(|(p, n)| {
+/// [`fitted_head`] of the first view, coloured from every view's picture where the head faces
+/// its camera (blended, weighted by how squarely it faces), and from its mirror image where no
+/// view sees it. A view is a fit and the picture it was fitted to.
+pub(crate) fn head_mesh(body: &BodyModel, face: &FaceModel, views: &[(&FaceFit, &Image)]) -> Result<TriMesh> {
+    let (shown, _) = views.first().context("a head needs at least one view to be coloured from")?;
+    let TriMesh { positions: head, faces, .. } = fitted_head(body, face, shown)?;
+    let mut sum = vec![([0.0f32; 3], 0.0f32); head.len()];
+    for (fitted, image) in views {
+        let posed = fitted_head(body, face, fitted)?.positions;
+        let normals = vertex_normals(&posed, &faces);
+        for ((p, n), acc) in posed.iter().zip(&normals).zip(&mut sum) {
             let x = fitted.to_camera(*p);
             let n = fitted.rotation * DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
-            if n.dot(-x.normalize()) < FACING {
-                return None;
+            let facing = n.dot(-x.normalize());
+            if facing < FACING {
+                continue;
             }
             let [u, v] = fitted.camera.project(x);
-            sample(image, u, v)
-        })
-        .collect();
+            if let Some(c) = sample(image, u, v) {
+                (0..3).for_each(|k| acc.0[k] += facing as f32 * c[k]);
+                acc.1 += facing as f32;
+            }
+        }
+    }
+    let seen: Vec<Option<[f32; 3]>> = sum.iter().map(|(c, w)| (*w > 0.0).then(|| c.map(|v| v / w))).collect();
     let fallback = {
         let known: Vec<&[f32; 3]> = seen.iter().flatten().collect();
         if known.is_empty() {

@@ -3,7 +3,8 @@
 //! points); the face's shape is fitted once, as the mean of full fits on a few frames spread over
 //! the clip, then each frame fits expression and head pose with that shape, started from and
 //! pulled toward the previous frame's fit. Writes `face.glb` (the expressions as morph targets,
-//! keyed per frame, and the head's motion), an overlay per frame, and `track.json`. A checkpoint
+//! keyed per frame, and the head's motion; its colours blended from the frames the shape was
+//! fitted on), an overlay per frame, and `track.json`. A checkpoint
 //! every 50 frames lets a stopped track resume; a finished one removes it.
 
 use std::path::{Path, PathBuf};
@@ -240,8 +241,16 @@ fn track_frames(args: &FaceTrackArgs, dir: Option<&Path>, start: Instant) -> Res
     let fit_seconds = fit_start.elapsed().as_secs_f64();
 
     let fps = args.fps.unwrap_or(DEFAULT_FPS);
-    let shown = done.fits[first].as_ref().expect("fitted");
-    let head = head_mesh(&body, &face, shown, &Image::read(&files[first])?)?;
+    // Coloured from the frames the shape was fitted on, the first one's head shown.
+    let mut views = Vec::new();
+    for i in spread(&found) {
+        if let Some(fit) = &done.fits[i] {
+            views.push((fit, Image::read(&files[i])?));
+        }
+    }
+    let views: Vec<(&FaceFit, &Image)> = views.iter().map(|(f, i)| (*f, i)).collect();
+    let shown = views[0].0;
+    let head = head_mesh(&body, &face, &views)?;
     let shapes = expression_shapes(&face, &head, &shown.expression);
     write_blend_shape_glb(args.out.join("face.glb"), &shapes, Some(&animation(&done.fits, fps)))?;
     write_video(&overlays, &args.out.join("overlay.mp4"), files.len(), fps as f32)?;
@@ -286,18 +295,22 @@ fn face_side(landmarks: &FaceLandmarks) -> f32 {
     (hi[0] - lo[0]).max(hi[1] - lo[1])
 }
 
-/// The face's shape for the whole video: the mean of full fits on up to `SHAPE_FRAMES` frames
-/// spread evenly over those with a face.
+/// Up to `SHAPE_FRAMES` of the frames with a face, spread evenly from the first to the last.
+fn spread(found: &[usize]) -> Vec<usize> {
+    match found.len() <= SHAPE_FRAMES {
+        true => found.to_vec(),
+        false => (0..SHAPE_FRAMES).map(|k| found[k * (found.len() - 1) / (SHAPE_FRAMES - 1)]).collect(),
+    }
+}
+
+/// The face's shape for the whole video: the mean of full fits on the frames [`spread`] picks.
 fn video_shape(
     fitter: &FaceFitter,
     files: &[PathBuf],
     landmarks: &[Option<FaceLandmarks>],
     found: &[usize],
 ) -> Result<Vec<f32>> {
-    let picks: Vec<usize> = match found.len() <= SHAPE_FRAMES {
-        true => found.to_vec(),
-        false => (0..SHAPE_FRAMES).map(|k| found[k * (found.len() - 1) / (SHAPE_FRAMES - 1)]).collect(),
-    };
+    let picks = spread(found);
     let fits: Vec<FaceFit> = picks
         .par_iter()
         .map(|&i| {
