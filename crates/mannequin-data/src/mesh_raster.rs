@@ -52,6 +52,8 @@ pub struct Raster {
     /// Camera-space z.
     pub depth: DepthMap,
     pub face_id: Vec<u32>,
+    /// The covered pixels' perspective-correct barycentrics in their face (zero elsewhere).
+    pub barycentrics: Vec<[f32; 3]>,
 }
 
 /// A triangle in screen space: pixel coordinates and camera-space depth per corner.
@@ -188,13 +190,15 @@ pub fn rasterize(mesh: &RasterMesh, camera: &Camera, background: [f32; 3]) -> Ra
     let mut normals = vec![[0.0f32; 3]; w * h];
     let mut depth = vec![0.0f32; w * h];
     let mut face_id = vec![NO_FACE; w * h];
+    let mut barycentrics = vec![[0.0f32; 3]; w * h];
     color
         .par_chunks_mut(BAND * w)
         .zip(normals.par_chunks_mut(BAND * w))
         .zip(depth.par_chunks_mut(BAND * w))
         .zip(face_id.par_chunks_mut(BAND * w))
+        .zip(barycentrics.par_chunks_mut(BAND * w))
         .enumerate()
-        .for_each(|(band, (((color, normals), depth), face_id))| {
+        .for_each(|(band, ((((color, normals), depth), face_id), barycentrics))| {
             let rows = color.len() / w;
             let vis = resolve_band(&tris, &bins[band], band * BAND, rows, w);
             for i in 0..rows * w {
@@ -209,6 +213,7 @@ pub fn rasterize(mesh: &RasterMesh, camera: &Camera, background: [f32; 3]) -> Ra
                 normals[i] = (rot32 * n).normalize_or_zero().to_array();
                 depth[i] = vis.depth[i] as f32;
                 face_id[i] = f;
+                barycentrics[i] = b;
                 color[i] = match mesh.shading {
                     Shading::Flat(c) => c,
                     Shading::Vertex(colours) => std::array::from_fn(|c| {
@@ -229,5 +234,6 @@ pub fn rasterize(mesh: &RasterMesh, camera: &Camera, background: [f32; 3]) -> Ra
         normals: NormalMap { width: w, height: h, normals },
         depth: DepthMap { width: w, height: h, depth },
         face_id,
+        barycentrics,
     }
 }

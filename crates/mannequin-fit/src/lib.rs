@@ -12,6 +12,7 @@ pub mod face_landmark_table;
 pub mod face_landmarker;
 pub mod face_models;
 pub mod face_render;
+pub mod face_texture;
 pub mod interpenetration;
 pub mod landmark_body;
 pub mod levenberg_marquardt;

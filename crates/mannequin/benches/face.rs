@@ -61,6 +61,14 @@ fn floats(v: &serde_json::Value) -> Vec<f32> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap() as f32).collect()
 }
 
+/// A fitted face as fit.json gives it.
+struct Placed {
+    shape: Vec<f32>,
+    expression: Vec<f32>,
+    rotation: DQuat,
+    translation: DVec3,
+}
+
 /// A face of the model: its coefficients and how it is shown.
 struct Truth {
     shape: Vec<f32>,
@@ -197,6 +205,62 @@ impl Scene {
             / qa.len() as f64
     }
 
+    /// How far `fitted` colours (per head vertex) and the picture sampled at the true head's
+    /// projected vertices are from the true albedo, over the face's vertices that face the
+    /// camera: mean absolute difference (0–255) after the per-channel gain that fits each best
+    /// (a colour scale and the light's strength cannot be told apart).
+    fn colour_errors(&self, truth: &Truth, picture: &Image, fitted: &[[f32; 3]], fit: &Placed) -> [f64; 3] {
+        let points = self.placed(&truth.shape, &truth.expression, truth.rotation, truth.translation);
+        let fit_points = self.placed(&fit.shape, &fit.expression, fit.rotation, fit.translation);
+        let as_f32: Vec<[f32; 3]> = points.iter().map(|p| p.as_vec3().to_array()).collect();
+        let normals = mannequin_mesh::normals::vertex_normals(&as_f32, &self.faces);
+        let camera = picture_camera(SIDE, SIDE, SIDE as f64);
+        let (mut truth_c, mut fit_c, mut sampled_c, mut projected_c) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for &v in &self.region {
+            let n = DVec3::from(normals[v].map(f64::from));
+            if n.dot(-points[v].normalize()) < 0.5 {
+                continue;
+            }
+            let [u, w] = camera.project(points[v]);
+            let (x, y) = (u.floor() as usize, w.floor() as usize);
+            if x >= SIDE || y >= SIDE {
+                continue;
+            }
+            let [u2, w2] = camera.project(fit_points[v]);
+            let (x2, y2) = ((u2.floor() as usize).min(SIDE - 1), (w2.floor() as usize).min(SIDE - 1));
+            truth_c.push(self.colours[v]);
+            fit_c.push(fitted[v]);
+            sampled_c.push(picture.at(x, y));
+            projected_c.push(picture.at(x2, y2));
+        }
+        let error = |estimate: &[[f32; 3]]| -> f64 {
+            let mut total = 0.0;
+            for c in 0..3 {
+                let (num, den) = estimate
+                    .iter()
+                    .zip(&truth_c)
+                    .fold((0.0, 0.0), |(n, d), (e, t)| (n + (e[c] * t[c]) as f64, d + (e[c] * e[c]) as f64));
+                let gain = num / den.max(1e-12);
+                total += estimate
+                    .iter()
+                    .zip(&truth_c)
+                    .map(|(e, t)| (gain * e[c] as f64 - t[c] as f64).abs())
+                    .sum::<f64>();
+            }
+            255.0 * total / (3 * truth_c.len().max(1)) as f64
+        };
+        [error(&fit_c), error(&projected_c), error(&sampled_c)]
+    }
+
+    /// The head's vertices placed in the camera.
+    fn placed(&self, shape: &[f32], expression: &[f32], rotation: DQuat, translation: DVec3) -> Vec<DVec3> {
+        self.head(shape, expression)
+            .iter()
+            .map(|p| rotation * (DVec3::from(p.map(f64::from)) - self.centre) + translation)
+            .collect()
+    }
+
     /// Mean distance over the face region between two rest heads, in millimetres.
     fn error_mm(&self, a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
         let d: f64 = self
@@ -247,10 +311,12 @@ fn main() {
         let (mut fit_mm, mut base_mm, mut lm, mut misses) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut truth_lm, mut shape_mm, mut expression_mm) = (Vec::new(), Vec::new(), Vec::new());
         let (mut aligned_mm, mut aligned_base_mm) = (Vec::new(), Vec::new());
+        let (mut colour_fit, mut colour_projected, mut colour_sampled) = (Vec::new(), Vec::new(), Vec::new());
         for k in 0..count {
             let truth = scene.random(&mut rng, size);
             let path = dir.join(format!("synthetic_{size}_{k}.png"));
-            scene.render(&truth).write_png(&path).unwrap();
+            let picture = scene.render(&truth);
+            picture.write_png(&path).unwrap();
             let out = dir.join(format!("synthetic_{size}_{k}"));
             if let Err(e) = mannequin(&["face", "fit", "--image", s(&path), "--out", s(&out)]) {
                 misses.push(e);
@@ -267,6 +333,20 @@ fn main() {
             base_mm.push(scene.error_mm(&neutral, &true_head));
             aligned_mm.push(scene.aligned_error_mm(&fitted, &true_head));
             aligned_base_mm.push(scene.aligned_error_mm(&neutral, &true_head));
+            let fitted_colours = read_obj(out.join("face.obj")).unwrap().colors.unwrap();
+            let q = floats(&report["head_rotation_xyzw"]);
+            let t = floats(&report["head_translation_m"]);
+            let fit = Placed {
+                shape: floats(&report["shape"]),
+                expression: floats(&report["expression"]),
+                rotation: DQuat::from_xyzw(q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64),
+                translation: DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64),
+            };
+            let [fitted_error, projected_error, sampled_error] =
+                scene.colour_errors(&truth, &picture, &fitted_colours, &fit);
+            colour_fit.push(fitted_error);
+            colour_projected.push(projected_error);
+            colour_sampled.push(sampled_error);
             lm.push(report["landmark_error_iod"]["mean"].as_f64().unwrap());
             let detected: Vec<Vec<f32>> =
                 report["landmarks_px"].as_array().unwrap().iter().map(floats).collect();
@@ -285,6 +365,12 @@ fn main() {
             100.0 * mean(&lm),
             100.0 * mean(&truth_lm),
             mean(&one_image[one_image.len() - fit_mm.len()..])
+        );
+        println!(
+            "  colour on the face's camera-facing vertices, off the true albedo (per-channel gain removed, 0–255): E_I's albedo {:.1}, the picture sampled at the fitted vertices {:.1}, at the true vertices {:.1}",
+            mean(&colour_fit),
+            mean(&colour_projected),
+            mean(&colour_sampled)
         );
         for e in misses {
             println!("  refused: {e}");

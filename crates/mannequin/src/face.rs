@@ -13,9 +13,9 @@ use glam::DVec3;
 use mannequin_body::{BodyModel, FaceModel};
 use mannequin_data::Image;
 use mannequin_fit::face_fit::{FaceFit, FaceFitter, OUTER_EYE_CORNERS};
+use mannequin_fit::face_texture::{Texture, View, fit_texture, mirror_vertices};
 use mannequin_fit::overlay::face_overlay;
 use mannequin_fit::{Face, FaceModels};
-use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::{BlendShapeMesh, TriMesh, write_blend_shape_glb};
 
 use crate::fit::FitArgs;
@@ -23,8 +23,6 @@ use crate::fit::FitArgs;
 /// The face mesh reads a 192² crop 1.5× the face box: a box much under 48 pixels is upsampled
 /// past what the network saw in training.
 pub(crate) const MIN_FACE_PX: f32 = 48.0;
-/// A vertex takes the photo's colour when its normal faces the camera at least this much.
-const FACING: f64 = 0.25;
 
 #[derive(Subcommand)]
 pub enum FaceCommand {
@@ -87,7 +85,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
     let fitted = fitter
         .fit(&face.landmarks)
         .with_context(|| format!("fitting the face in {}", args.image.display()))?;
-    let head = head_mesh(&body, &face_model, &[(&fitted, &image)])?;
+    let (head, texture) = head_mesh(&body, &face_model, &[(&fitted, &image)])?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     crate::body::write_mesh(&args.out.join("face.obj"), &head)?;
     let shapes = expression_shapes(&face_model, &head, &fitted.expression);
@@ -95,7 +93,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
     let picture =
         face_overlay(&image, &face.landmarks.points, &fitted.reprojected, &projected_edges(&head, &fitted));
     picture.write_png(&args.out.join("overlay.png"))?;
-    let report = report(face, &fitted, start.elapsed().as_secs_f64());
+    let report = report(face, &fitted, &texture, start.elapsed().as_secs_f64());
     mannequin_io::write_atomic(&args.out.join("fit.json"), serde_json::to_string_pretty(&report)?.as_bytes())
         .with_context(|| format!("writing {}", args.out.join("fit.json").display()))?;
     tracing::info!(
@@ -123,56 +121,31 @@ pub(crate) fn fitted_head(body: &BodyModel, face: &FaceModel, fitted: &FaceFit) 
     Ok(TriMesh::new(head, faces))
 }
 
-/// [`fitted_head`] of the first view, coloured from every view's picture where the head faces
-/// its camera (blended, weighted by how squarely it faces), and from its mirror image where no
-/// view sees it. A view is a fit and the picture it was fitted to.
-pub(crate) fn head_mesh(body: &BodyModel, face: &FaceModel, views: &[(&FaceFit, &Image)]) -> Result<TriMesh> {
+/// [`fitted_head`] of the first view, coloured by the photometric term over every view
+/// (`mannequin_fit::face_texture`: an albedo per vertex and a light per view). A view is a fit
+/// and the picture it was fitted to.
+pub(crate) fn head_mesh(
+    body: &BodyModel,
+    face: &FaceModel,
+    views: &[(&FaceFit, &Image)],
+) -> Result<(TriMesh, Texture)> {
     let (shown, _) = views.first().context("a head needs at least one view to be coloured from")?;
-    let TriMesh { positions: head, faces, .. } = fitted_head(body, face, shown)?;
-    let mut sum = vec![([0.0f32; 3], 0.0f32); head.len()];
-    for (fitted, image) in views {
-        let posed = fitted_head(body, face, fitted)?.positions;
-        let normals = vertex_normals(&posed, &faces);
-        for ((p, n), acc) in posed.iter().zip(&normals).zip(&mut sum) {
-            let x = fitted.to_camera(*p);
-            let n = fitted.rotation * DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
-            let facing = n.dot(-x.normalize());
-            if facing < FACING {
-                continue;
-            }
-            let [u, v] = fitted.camera.project(x);
-            if let Some(c) = sample(image, u, v) {
-                (0..3).for_each(|k| acc.0[k] += facing as f32 * c[k]);
-                acc.1 += facing as f32;
-            }
-        }
-    }
-    let seen: Vec<Option<[f32; 3]>> = sum.iter().map(|(c, w)| (*w > 0.0).then(|| c.map(|v| v / w))).collect();
-    let fallback = {
-        let known: Vec<&[f32; 3]> = seen.iter().flatten().collect();
-        if known.is_empty() {
-            bail!("no vertex of the fitted head faces the camera");
-        }
-        std::array::from_fn(|c| known.iter().map(|k| k[c]).sum::<f32>() / known.len() as f32)
-    };
-    // Where the head is unseen, the colour of the vertex nearest its mirror image (x → −x).
-    let colors = head
+    let mut head = fitted_head(body, face, shown)?;
+    let placed = views
         .iter()
-        .zip(&seen)
-        .map(|(p, s)| {
-            s.unwrap_or_else(|| {
-                let mirror = [-p[0], p[1], p[2]];
-                let nearest = head
-                    .iter()
-                    .enumerate()
-                    .min_by(|a, b| distance2(a.1, &mirror).total_cmp(&distance2(b.1, &mirror)))
-                    .map(|(i, _)| i)
-                    .expect("the head has vertices");
-                seen[nearest].unwrap_or(fallback)
-            })
+        .map(|(fit, _)| {
+            Ok(fitted_head(body, face, fit)?.positions.iter().map(|p| fit.to_camera(*p)).collect())
         })
+        .collect::<Result<Vec<Vec<DVec3>>>>()?;
+    let pictures: Vec<View> = placed
+        .iter()
+        .zip(views)
+        .map(|(points, (fit, image))| View { points, camera: &fit.camera, image })
         .collect();
-    Ok(TriMesh { positions: head, faces, uv: None, colors: Some(colors) })
+    let rest: Vec<[f32; 3]> = face.vertices.iter().map(|&v| body.v_template[v]).collect();
+    let texture = fit_texture(&pictures, &head.faces, &mirror_vertices(&rest))?;
+    head.colors = Some(texture.albedo.clone());
+    Ok((head, texture))
 }
 
 /// The fitted head as blend shapes: the 52 expression units as named morph targets over the
@@ -201,24 +174,6 @@ pub(crate) fn expression_shapes(face: &FaceModel, head: &TriMesh, expression: &[
     }
 }
 
-fn distance2(a: &[f32; 3], b: &[f32; 3]) -> f32 {
-    (0..3).map(|c| (a[c] - b[c]).powi(2)).sum()
-}
-
-/// The photo's colour at (u, v), bilinear; None off the picture.
-fn sample(image: &Image, u: f64, v: f64) -> Option<[f32; 3]> {
-    let (x, y) = (u - 0.5, v - 0.5);
-    if !(x >= 0.0 && y >= 0.0 && x <= (image.width - 1) as f64 && y <= (image.height - 1) as f64) {
-        return None;
-    }
-    let (i, j) = ((x as usize).min(image.width - 2), (y as usize).min(image.height - 2));
-    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
-    let (a, b, c, d) = (image.at(i, j), image.at(i + 1, j), image.at(i, j + 1), image.at(i + 1, j + 1));
-    Some(std::array::from_fn(|k| {
-        (a[k] * (1.0 - fx) + b[k] * fx) * (1.0 - fy) + (c[k] * (1.0 - fx) + d[k] * fx) * fy
-    }))
-}
-
 /// The head's edges that face the camera, projected: what the overlay draws.
 pub(crate) fn projected_edges(head: &TriMesh, fitted: &FaceFit) -> Vec<[[f32; 2]; 2]> {
     let mut edges = Vec::new();
@@ -235,7 +190,7 @@ pub(crate) fn projected_edges(head: &TriMesh, fitted: &FaceFit) -> Vec<[[f32; 2]
     edges
 }
 
-fn report(face: &Face, fitted: &FaceFit, seconds: f64) -> serde_json::Value {
+fn report(face: &Face, fitted: &FaceFit, texture: &Texture, seconds: f64) -> serde_json::Value {
     let mut sorted = fitted.errors_iod.clone();
     sorted.sort_by(f32::total_cmp);
     let [a, b] = OUTER_EYE_CORNERS.map(|i| face.landmarks.points[i]);
@@ -255,7 +210,8 @@ fn report(face: &Face, fitted: &FaceFit, seconds: f64) -> serde_json::Value {
         "head_rotation_xyzw": fitted.rotation.to_array(),
         "head_translation_m": fitted.translation.to_array(),
         "focal_px": fitted.camera.intrinsic[0][0],
-        "photometric_error": serde_json::Value::Null,
+        "photometric_error_rms": texture.rms,
+        "light": { "ambient": texture.lights[0][0], "direction_camera": &texture.lights[0][1..] },
         "stages": fitted.stages.iter().map(|s| serde_json::json!({
             "initial_cost": s.initial_cost, "final_cost": s.final_cost, "iterations": s.iterations,
         })).collect::<Vec<_>>(),

@@ -250,7 +250,7 @@ fn track_frames(args: &FaceTrackArgs, dir: Option<&Path>, start: Instant) -> Res
     }
     let views: Vec<(&FaceFit, &Image)> = views.iter().map(|(f, i)| (*f, i)).collect();
     let shown = views[0].0;
-    let head = head_mesh(&body, &face, &views)?;
+    let (head, texture) = head_mesh(&body, &face, &views)?;
     let shapes = expression_shapes(&face, &head, &shown.expression);
     write_blend_shape_glb(args.out.join("face.glb"), &shapes, Some(&animation(&done.fits, fps)))?;
     write_video(&overlays, &args.out.join("overlay.mp4"), files.len(), fps as f32)?;
@@ -267,6 +267,7 @@ fn track_frames(args: &FaceTrackArgs, dir: Option<&Path>, start: Instant) -> Res
             "total": start.elapsed().as_secs_f64(),
         },
         "tracking_frames_per_second": per_second,
+        "photometric_error_rms": texture.rms,
     });
     let path = args.out.join("track.json");
     mannequin_io::write_atomic(&path, serde_json::to_string_pretty(&report)?.as_bytes())
