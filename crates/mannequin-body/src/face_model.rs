@@ -6,6 +6,7 @@
 
 use mannequin_io::Npz;
 
+use crate::BodyModel;
 use crate::error::BodyError;
 
 static FACE: &[u8] = include_bytes!("../assets/default_face.npz");
@@ -70,6 +71,15 @@ impl FaceModel {
         self.expression_names.len()
     }
 
+    /// The body's triangles whose corners are all head vertices, in head-vertex indices (the
+    /// order of `vertices`): the head as a mesh of its own.
+    pub fn head_faces(&self, body: &BodyModel) -> Vec<[u32; 3]> {
+        let mut slot = vec![None; body.num_vertices()];
+        self.vertices.iter().enumerate().for_each(|(i, &v)| slot[v] = Some(i as u32));
+        let at = |v: u32| slot.get(v as usize).copied().flatten();
+        body.faces.iter().filter_map(|f| Some([at(f[0])?, at(f[1])?, at(f[2])?])).collect()
+    }
+
     /// The expression unit called `name` (ARKit's names: `jawOpen`, `eyeBlinkLeft`, ...).
     pub fn expression(&self, name: &str) -> Option<usize> {
         self.expression_names.iter().position(|n| n == name)
@@ -121,7 +131,6 @@ impl FaceModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::BodyModel;
 
     /// A head vertex at rest and how far a unit moves it.
     type Move = ([f32; 3], [f32; 3]);

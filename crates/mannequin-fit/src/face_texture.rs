@@ -268,13 +268,7 @@ mod tests {
     #[test]
     fn the_albedo_is_the_paint_seen_and_its_mirror_unseen() {
         let (body, face) = (BodyModel::default_body(), FaceModel::default_face());
-        let mut slot = vec![None; body.num_vertices()];
-        face.vertices.iter().enumerate().for_each(|(i, &v)| slot[v] = Some(i as u32));
-        let faces: Vec<[u32; 3]> = body
-            .faces
-            .iter()
-            .filter_map(|f| Some([slot[f[0] as usize]?, slot[f[1] as usize]?, slot[f[2] as usize]?]))
-            .collect();
+        let faces = face.head_faces(&body);
         let rest: Vec<[f32; 3]> = face.vertices.iter().map(|&v| body.v_template[v]).collect();
         let paint: Vec<[f32; 3]> = rest
             .iter()

@@ -95,13 +95,7 @@ struct Scene {
 impl Scene {
     fn new(colours: Vec<[f32; 3]>) -> Self {
         let (body, face) = (BodyModel::default_body(), FaceModel::default_face());
-        let mut index = vec![None; body.num_vertices()];
-        face.vertices.iter().enumerate().for_each(|(i, &v)| index[v] = Some(i as u32));
-        let faces = body
-            .faces
-            .iter()
-            .filter_map(|f| Some([index[f[0] as usize]?, index[f[1] as usize]?, index[f[2] as usize]?]))
-            .collect();
+        let faces = face.head_faces(&body);
         let points = FaceLandmarkTable::default_head().positions(&body.v_template, &body.faces).unwrap();
         let centre =
             points.iter().map(|p| DVec3::from(p.map(f64::from))).sum::<DVec3>() / points.len() as f64;

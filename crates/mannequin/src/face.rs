@@ -110,13 +110,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
 pub(crate) fn fitted_head(body: &BodyModel, face: &FaceModel, fitted: &FaceFit) -> Result<TriMesh> {
     let mut positions = body.v_template.clone();
     face.apply(&mut positions, &fitted.shape, &fitted.expression)?;
-    let mut index = vec![None; positions.len()];
-    face.vertices.iter().enumerate().for_each(|(i, &v)| index[v] = Some(i as u32));
-    let faces: Vec<[u32; 3]> = body
-        .faces
-        .iter()
-        .filter_map(|f| Some([index[f[0] as usize]?, index[f[1] as usize]?, index[f[2] as usize]?]))
-        .collect();
+    let faces = face.head_faces(body);
     let head: Vec<[f32; 3]> = face.vertices.iter().map(|&v| positions[v]).collect();
     Ok(TriMesh::new(head, faces))
 }
