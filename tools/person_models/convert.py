@@ -592,19 +592,26 @@ def pipeline(rgb):
     return out
 
 
+def face_mesh_solution(use_prev_landmarks, outputs):
+    """The legacy FaceMesh solution's graph (max_num_faces=1, refine_landmarks=False) through its
+    SolutionBase, with the same side inputs and parameters, asking for `outputs`; with
+    `use_prev_landmarks` it is FaceMesh(static_image_mode=False)."""
+    from mediapipe.python.solution_base import SolutionBase
+    from mediapipe.python.solutions import face_mesh
+    return SolutionBase(
+        binary_graph_path=face_mesh._BINARYPB_FILE_PATH,
+        side_inputs={"num_faces": 1, "with_attention": False, "use_prev_landmarks": use_prev_landmarks},
+        calculator_params={
+            "facedetectionshortrangecpu__facedetectionshortrange__facedetection__TensorsToDetectionsCalculator.min_score_thresh": 0.5,
+            "facelandmarkcpu__ThresholdingCalculator.threshold": 0.5},
+        outputs=outputs)
+
+
 def face_pipeline(rgb):
     """mp.solutions.face_mesh.FaceMesh(static_image_mode=True, max_num_faces=1,
     refine_landmarks=False), through its SolutionBase with the same graph, side inputs and
     parameters, asking for the face detection and the crop it made too."""
-    from mediapipe.python.solution_base import SolutionBase
-    from mediapipe.python.solutions import face_mesh
-    solution = SolutionBase(
-        binary_graph_path=face_mesh._BINARYPB_FILE_PATH,
-        side_inputs={"num_faces": 1, "with_attention": False, "use_prev_landmarks": False},
-        calculator_params={
-            "facedetectionshortrangecpu__facedetectionshortrange__facedetection__TensorsToDetectionsCalculator.min_score_thresh": 0.5,
-            "facelandmarkcpu__ThresholdingCalculator.threshold": 0.5},
-        outputs=["multi_face_landmarks", "face_detections", "face_rects_from_detections"])
+    solution = face_mesh_solution(False, ["multi_face_landmarks", "face_detections", "face_rects_from_detections"])
     with solution:
         r = solution.process({"image": rgb})
     h, w = rgb.shape[:2]
@@ -634,15 +641,7 @@ def face_track(rgb):
     """mp.solutions.face_mesh.FaceMesh(static_image_mode=False, max_num_faces=1,
     refine_landmarks=False) over the windows: after the first frame each crop comes from the
     previous frame's landmarks (MediaPipe's tracking)."""
-    from mediapipe.python.solution_base import SolutionBase
-    from mediapipe.python.solutions import face_mesh
-    solution = SolutionBase(
-        binary_graph_path=face_mesh._BINARYPB_FILE_PATH,
-        side_inputs={"num_faces": 1, "with_attention": False, "use_prev_landmarks": True},
-        calculator_params={
-            "facedetectionshortrangecpu__facedetectionshortrange__facedetection__TensorsToDetectionsCalculator.min_score_thresh": 0.5,
-            "facelandmarkcpu__ThresholdingCalculator.threshold": 0.5},
-        outputs=["multi_face_landmarks", "face_rects_from_landmarks"])
+    solution = face_mesh_solution(True, ["multi_face_landmarks", "face_rects_from_landmarks"])
     n = TRACK_WINDOW
     landmarks, rois = [], []
     with solution:

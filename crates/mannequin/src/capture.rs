@@ -4,14 +4,13 @@
 //! every frame (`mannequin_fit::capture`), plus an overlay per frame to check the fit by.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use glam::{DMat3, DMat4, DVec3};
 use mannequin_body::BodyModel;
 use mannequin_body::rodrigues::axis_angle_quat;
-use mannequin_data::layout::{self, IMAGE_EXTENSIONS};
+use mannequin_data::layout;
 use mannequin_data::maps::read_mask_npy;
 use mannequin_data::splits::SplitRange;
 use mannequin_data::{Camera, Cameras, DatasetWriter, Frame, Image, Poses, Splits};
@@ -23,27 +22,18 @@ use mannequin_fit::{BodyFit, PersonModels};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::body::load_body;
-use crate::checkpoint::{CHECKPOINT, add_run, check_run, file_hash};
+use crate::checkpoint::{CHECKPOINT, add_run, check_run};
 use crate::fit::{FitArgs, check_picture, posed_mesh};
 use crate::progress::{JobTimer, bar};
+use crate::video_input::{Frames, VideoArgs};
 
 /// The last tenth of the frames (at least one) is held out as the test split.
 const TEST_SHARE: usize = 10;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// A folder of frames (PNG or JPEG), taken in file-name order.
-    #[arg(long, conflicts_with = "video", required_unless_present = "video")]
-    frames: Option<PathBuf>,
-    /// A video file, decoded by the ffmpeg program.
-    #[arg(long)]
-    video: Option<PathBuf>,
-    /// Frames per second taken from the video (default: every frame).
-    #[arg(long)]
-    fps: Option<f64>,
-    /// Use at most this many frames, from the start.
-    #[arg(long)]
-    max_frames: Option<usize>,
+    #[command(flatten)]
+    input: VideoArgs,
     #[command(flatten)]
     fitting: FitArgs,
     /// The dataset folder to write. A capture that was stopped resumes from its checkpoint there.
@@ -77,25 +67,14 @@ pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("capture");
     let start = Instant::now();
     args.fitting.check()?;
-    let decoded = match &args.video {
-        Some(video) => Some(decode_video(video, args.fps, &args.out)?),
-        None => None,
-    };
-    let dir = decoded.as_deref().or(args.frames.as_deref()).context("give --frames DIR or --video FILE")?;
-    let mut files = frame_files(dir)?;
-    if let Some(n) = args.max_frames {
-        files.truncate(n);
-    }
+    let Frames { dir, files, decoded } = args.input.frames(&args.out)?;
     if files.len() < 2 {
         bail!("{}: {} frame(s); a capture needs at least 2", dir.display(), files.len());
     }
     let run = CaptureRun {
-        source: match &args.video {
-            Some(video) => vec![format!("{} {}", video.display(), file_hash(video)?)],
-            None => frame_hashes(&files)?,
-        },
-        fps: args.fps,
-        max_frames: args.max_frames,
+        source: args.input.source(&files)?,
+        fps: args.input.fps,
+        max_frames: args.input.max_frames,
         body: args.fitting.body.clone(),
         focal: args.fitting.focal,
     };
@@ -135,8 +114,8 @@ pub fn run(args: Args) -> Result<()> {
     let Saved { kept, skipped, .. } = &saved;
     write_dataset(&args.out, &model, &fits, args.moving_camera)?;
     let ious = write_overlays(&args.out, &model, kept, &people_read, &fits)?;
-    if decoded.is_some() {
-        std::fs::remove_dir_all(dir).with_context(|| format!("removing {}", dir.display()))?;
+    if decoded {
+        std::fs::remove_dir_all(&dir).with_context(|| format!("removing {}", dir.display()))?;
     }
     let report = report(kept, &fits, &ious, skipped, &mirrored, focal, start.elapsed().as_secs_f64());
     mannequin_io::write_atomic(
@@ -154,11 +133,6 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-/// Each frame file's name and hash: a checkpoint is only resumed on the same frames.
-fn frame_hashes(files: &[PathBuf]) -> Result<Vec<String>> {
-    files.iter().map(|f| Ok(format!("{} {}", f.display(), file_hash(f)?))).collect()
-}
-
 /// What a capture has done so far: frames tracked (the kept ones written to the dataset as they
 /// come), and the fit's passes.
 #[derive(Default)]
@@ -169,48 +143,6 @@ struct Saved {
     people: Vec<PoseLandmarks>,
     skipped: Vec<PathBuf>,
     fit: ClipProgress,
-}
-
-/// Decodes `video` into PNG frames under `out/.frames` with ffmpeg.
-pub(crate) fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
-    if !video.is_file() {
-        bail!("{}: no such video file", video.display());
-    }
-    let dir = out.join(".frames");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut cmd = Command::new("ffmpeg");
-    cmd.args(["-loglevel", "error", "-i"]).arg(video);
-    if let Some(f) = fps {
-        cmd.args(["-vf", &format!("fps={f}")]);
-    }
-    let status = match cmd.arg(dir.join("%06d.png")).status() {
-        Ok(s) => s,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
-            "--video needs the ffmpeg program, which is not on PATH: install it (Debian/Ubuntu: \
-             sudo apt-get install ffmpeg; macOS: brew install ffmpeg), or pass --frames DIR with the frames as images"
-        ),
-        Err(e) => bail!("running ffmpeg: {e}"),
-    };
-    if !status.success() {
-        bail!("{}: ffmpeg could not decode it ({status})", video.display());
-    }
-    Ok(dir)
-}
-
-/// The image files of a folder, in name order.
-pub(crate) fn frame_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
-    let mut files: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
-        })
-        .collect();
-    files.sort();
-    Ok(files)
 }
 
 /// Each frame's image and the person's landmarks, from where `saved` left off; frames where nobody

@@ -55,13 +55,7 @@ pub fn run(command: FaceCommand) -> Result<()> {
 
 fn fit(args: FaceFitArgs) -> Result<()> {
     let start = Instant::now();
-    args.fitting.check()?;
-    if args.fitting.body != "default" {
-        bail!(
-            "--body {}: the face model is the embedded default body's; use --body default",
-            args.fitting.body
-        );
-    }
+    check_face_body(&args.fitting)?;
     let image = Image::read(&args.image)?;
     let models = FaceModels::load()?;
     let faces = models.faces(&image)?;
@@ -103,6 +97,15 @@ fn fit(args: FaceFitArgs) -> Result<()> {
         start.elapsed().as_secs_f64(),
         args.out.display()
     );
+    Ok(())
+}
+
+/// Refuses a focal length that is no length and a body the face model is not made for.
+pub(crate) fn check_face_body(fitting: &FitArgs) -> Result<()> {
+    fitting.check()?;
+    if fitting.body != "default" {
+        bail!("--body {}: the face model is the embedded default body's; use --body default", fitting.body);
+    }
     Ok(())
 }
 

@@ -24,11 +24,11 @@ use mannequin_mesh::{BlendShapeAnimation, write_blend_shape_glb};
 use rayon::prelude::*;
 
 use crate::animate::write_video;
-use crate::capture::{decode_video, frame_files};
-use crate::checkpoint::{CHECKPOINT, add_run, check_run, file_hash};
-use crate::face::{MIN_FACE_PX, expression_shapes, fitted_head, head_mesh, projected_edges};
+use crate::checkpoint::{CHECKPOINT, add_run, check_run};
+use crate::face::{MIN_FACE_PX, check_face_body, expression_shapes, fitted_head, head_mesh, projected_edges};
 use crate::fit::FitArgs;
 use crate::progress::{JobTimer, bar};
+use crate::video_input::{Frames, VideoArgs};
 
 /// Frames whose full fits are averaged into the video's face shape.
 const SHAPE_FRAMES: usize = 5;
@@ -37,19 +37,8 @@ const DEFAULT_FPS: f64 = 30.0;
 
 #[derive(clap::Args)]
 pub struct FaceTrackArgs {
-    /// A folder of frames (PNG or JPEG), taken in file-name order.
-    #[arg(long, conflicts_with = "video", required_unless_present = "video")]
-    frames: Option<PathBuf>,
-    /// A video file, decoded by the ffmpeg program.
-    #[arg(long)]
-    video: Option<PathBuf>,
-    /// Frames per second: taken from the video (default: every frame), and the animation's rate
-    /// (default 30 for a folder of frames).
-    #[arg(long)]
-    fps: Option<f64>,
-    /// Use at most this many frames, from the start.
-    #[arg(long)]
-    max_frames: Option<usize>,
+    #[command(flatten)]
+    input: VideoArgs,
     #[command(flatten)]
     fitting: FitArgs,
     /// Output folder. A track that was stopped resumes from its checkpoint there.
@@ -85,49 +74,25 @@ struct Done {
 pub fn track(args: FaceTrackArgs) -> Result<()> {
     let _timer = JobTimer::start("face track");
     let start = Instant::now();
-    args.fitting.check()?;
-    if args.fitting.body != "default" {
-        bail!(
-            "--body {}: the face model is the embedded default body's; use --body default",
-            args.fitting.body
-        );
-    }
-    if let Some(fps) = args.fps
-        && !(fps.is_finite() && fps > 0.0)
-    {
-        bail!("--fps {fps}: expected a positive frame rate");
-    }
+    check_face_body(&args.fitting)?;
     let scratch = args.out.with_extension("frames.partial");
-    let decoded = match &args.video {
-        Some(video) => Some(decode_video(video, args.fps, &scratch)?),
-        None => None,
-    };
-    let result = track_frames(&args, decoded.as_deref().or(args.frames.as_deref()), start);
-    if decoded.is_some() {
+    let frames = args.input.frames(&scratch)?;
+    let result = track_frames(&args, &frames, start);
+    if frames.decoded {
         let _ = std::fs::remove_dir_all(&scratch);
     }
     result
 }
 
-fn track_frames(args: &FaceTrackArgs, dir: Option<&Path>, start: Instant) -> Result<()> {
-    let dir = dir.context("give --frames DIR or --video FILE")?;
-    let mut files = frame_files(dir)?;
-    if let Some(n) = args.max_frames {
-        files.truncate(n);
-    }
+fn track_frames(args: &FaceTrackArgs, frames: &Frames, start: Instant) -> Result<()> {
+    let Frames { dir, files, .. } = frames;
     if files.is_empty() {
         bail!("{}: no frames (PNG or JPEG) to track", dir.display());
     }
     let run = TrackRun {
-        source: match &args.video {
-            Some(video) => vec![format!("{} {}", video.display(), file_hash(video)?)],
-            None => files
-                .iter()
-                .map(|f| Ok(format!("{} {}", f.display(), file_hash(f)?)))
-                .collect::<Result<_>>()?,
-        },
-        fps: args.fps,
-        max_frames: args.max_frames,
+        source: args.input.source(files)?,
+        fps: args.input.fps,
+        max_frames: args.input.max_frames,
         focal: args.fitting.focal,
     };
     let checkpoint = args.out.join(CHECKPOINT);
@@ -240,7 +205,7 @@ fn track_frames(args: &FaceTrackArgs, dir: Option<&Path>, start: Instant) -> Res
     progress.finish();
     let fit_seconds = fit_start.elapsed().as_secs_f64();
 
-    let fps = args.fps.unwrap_or(DEFAULT_FPS);
+    let fps = args.input.fps.unwrap_or(DEFAULT_FPS);
     // Coloured from the frames the shape was fitted on, the first one's head shown.
     let mut views = Vec::new();
     for i in spread(&found) {

@@ -22,6 +22,7 @@ mod render;
 mod splat;
 mod synth;
 mod train;
+mod video_input;
 
 use clap::{Parser, Subcommand};
 

@@ -1,0 +1,107 @@
+//! Where the video commands (`capture`, `face track`) take their frames from: a folder of images,
+//! or a video file decoded by the ffmpeg program.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+use mannequin_data::layout::IMAGE_EXTENSIONS;
+
+use crate::checkpoint::file_hash;
+
+#[derive(clap::Args)]
+pub struct VideoArgs {
+    /// A folder of frames (PNG or JPEG), taken in file-name order.
+    #[arg(long, conflicts_with = "video", required_unless_present = "video")]
+    pub frames: Option<PathBuf>,
+    /// A video file, decoded by the ffmpeg program.
+    #[arg(long)]
+    pub video: Option<PathBuf>,
+    /// Frames per second taken from the video (default: every frame); `face track` also keys its
+    /// animation at this rate (by default 30 for a folder of frames).
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// Use at most this many frames, from the start.
+    #[arg(long)]
+    pub max_frames: Option<usize>,
+}
+
+/// A command's frames, and the folder they are in.
+pub struct Frames {
+    pub dir: PathBuf,
+    pub files: Vec<PathBuf>,
+    /// Whether `dir` was decoded from the video (and is the command's to remove).
+    pub decoded: bool,
+}
+
+impl VideoArgs {
+    /// The frames, the video first decoded into `scratch/.frames`; at most `--max-frames`.
+    pub fn frames(&self, scratch: &Path) -> Result<Frames> {
+        if let Some(fps) = self.fps
+            && !(fps.is_finite() && fps > 0.0)
+        {
+            bail!("--fps {fps}: expected a positive frame rate");
+        }
+        let (dir, decoded) = match (&self.video, &self.frames) {
+            (Some(video), _) => (decode_video(video, self.fps, scratch)?, true),
+            (None, Some(dir)) => (dir.clone(), false),
+            (None, None) => bail!("give --frames DIR or --video FILE"),
+        };
+        let mut files = image_files(&dir)?;
+        if let Some(n) = self.max_frames {
+            files.truncate(n);
+        }
+        Ok(Frames { dir, files, decoded })
+    }
+
+    /// The video's name and hash, or each frame file's: a checkpoint resumes only on the same
+    /// input.
+    pub fn source(&self, files: &[PathBuf]) -> Result<Vec<String>> {
+        match &self.video {
+            Some(video) => Ok(vec![format!("{} {}", video.display(), file_hash(video)?)]),
+            None => files.iter().map(|f| Ok(format!("{} {}", f.display(), file_hash(f)?))).collect(),
+        }
+    }
+}
+
+/// Decodes `video` into PNG frames under `out/.frames` with ffmpeg.
+fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
+    if !video.is_file() {
+        bail!("{}: no such video file", video.display());
+    }
+    let dir = out.join(".frames");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut cmd = Command::new("ffmpeg");
+    cmd.args(["-loglevel", "error", "-i"]).arg(video);
+    if let Some(f) = fps {
+        cmd.args(["-vf", &format!("fps={f}")]);
+    }
+    let status = match cmd.arg(dir.join("%06d.png")).status() {
+        Ok(s) => s,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
+            "--video needs the ffmpeg program, which is not on PATH: install it (Debian/Ubuntu: \
+             sudo apt-get install ffmpeg; macOS: brew install ffmpeg), or pass --frames DIR with the frames as images"
+        ),
+        Err(e) => bail!("running ffmpeg: {e}"),
+    };
+    if !status.success() {
+        bail!("{}: ffmpeg could not decode it ({status})", video.display());
+    }
+    Ok(dir)
+}
+
+/// The image files of a folder, in name order.
+fn image_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+        })
+        .collect();
+    files.sort();
+    Ok(files)
+}
