@@ -164,7 +164,7 @@ fn track_frames(args: &FaceTrackArgs, frames: &Frames, start: Instant) -> Result
     let shape = match &done.shape {
         Some(shape) => shape.clone(),
         None => {
-            let shape = video_shape(&fitter, &files, &done.landmarks, &found)?;
+            let shape = video_shape(&fitter, files, &done.landmarks, &found)?;
             done.shape = Some(shape.clone());
             save(&done)?;
             shape
