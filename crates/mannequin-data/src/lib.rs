@@ -2,6 +2,7 @@
 //! rasterizer for ground-truth images, synthetic subjects, and the metrics the papers report.
 
 pub mod dataset;
+pub mod diff_raster;
 pub mod error;
 pub mod evaluation;
 pub mod fingerprint;
