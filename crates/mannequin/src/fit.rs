@@ -93,7 +93,7 @@ pub fn run(args: Args) -> Result<()> {
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
     let head = match args.no_face || args.fitting.body != "default" {
         true => Head::NotAsked,
-        false => fit_head(&image, &landmarks, focal)
+        false => fit_head(&model, &image, &landmarks, focal)
             .with_context(|| format!("fitting the face in {}", args.image.display()))?,
     };
     let model = match &head {
@@ -150,7 +150,7 @@ impl Head {
 
 /// The face (thesis §2.3) of the person whose body was fitted: the largest face whose box holds
 /// the body's nose landmark, when it is large enough to fit.
-fn fit_head(image: &Image, landmarks: &PoseLandmarks, focal: f64) -> Result<Head> {
+fn fit_head(body: &BodyModel, image: &Image, landmarks: &PoseLandmarks, focal: f64) -> Result<Head> {
     let nose = landmarks.points[0];
     let faces = FaceModels::load()?.faces(image)?;
     let Some(face) = faces.into_iter().find(|f| {
