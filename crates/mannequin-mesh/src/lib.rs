@@ -14,6 +14,7 @@ pub mod normals;
 pub mod obj;
 pub mod pc2;
 pub mod ply;
+pub mod poisson;
 pub mod remesh;
 pub mod ring_tube;
 pub mod subdivide;

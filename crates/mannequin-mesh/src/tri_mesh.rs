@@ -33,6 +33,12 @@ pub enum MeshError {
     ColorCount { count: usize, vertices: usize },
     #[error("vertex {vertex} is not finite")]
     NonFinite { vertex: usize },
+    #[error("vertex {pinned} pinned, but the mesh has {count} vertices")]
+    PinnedVertex { pinned: usize, count: usize },
+    #[error(
+        "the Poisson system cannot be factored ({0}): the mesh has degenerate faces or parts not connected to the pinned vertex"
+    )]
+    Poisson(String),
 }
 
 impl TriMesh {
