@@ -8,6 +8,7 @@ pub mod closest_point;
 pub mod file_error;
 pub mod gltf;
 pub mod gradient;
+pub mod jacobian_field;
 pub mod laplacian;
 pub mod mass;
 pub mod normals;

@@ -141,3 +141,61 @@ fn meshes_it_cannot_solve_are_refused() {
     let e = PoissonSolve::new(&two, &[[0, 1, 2], [3, 4, 5]], 0).err().unwrap().to_string();
     assert!(e.contains("not connected to the pinned vertex"), "{e}");
 }
+
+/// NGD's deformation: M = I integrates back to the rest mesh, a constant M to the rest mesh
+/// mapped by M (about the pinned vertex), and the backward pass to M matches differences.
+#[test]
+fn jacobian_fields_deform_the_rest_mesh() {
+    use mannequin_mesh::jacobian_field::{deform, deform_backward, rest_jacobians};
+    let (rest, faces) = grid();
+    let solve = PoissonSolve::new(&rest, &faces, 10).unwrap();
+    let jacobians = rest_jacobians(&rest, &faces);
+    let p = |v: usize| rest[v].map(f64::from);
+    let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    // A rotation about (1, 2, 2)/3 by 0.5 rad, scaled by 1.2 along x.
+    let turn = glam::DMat3::from_axis_angle(glam::DVec3::new(1.0, 2.0, 2.0) / 3.0, 0.5);
+    let m: Jacobian =
+        std::array::from_fn(|i| std::array::from_fn(|k| turn.col(k)[i] * if k == 0 { 1.2 } else { 1.0 }));
+    for (name, matrix) in [("identity", identity), ("turned and stretched", m)] {
+        let field = vec![matrix; faces.len()];
+        let x = solve.solve(&deform(&field, &jacobians), p(10));
+        let worst = (0..rest.len())
+            .map(|v| {
+                let want: [f64; 3] = std::array::from_fn(|i| {
+                    p(10)[i] + (0..3).map(|k| matrix[i][k] * (p(v)[k] - p(10)[k])).sum::<f64>()
+                });
+                (0..3).map(|d| (x[v][d] - want[d]).abs()).fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{name}: {worst} from the rest mesh mapped by M");
+    }
+    let field: Vec<Jacobian> = (0..faces.len())
+        .map(|f| {
+            std::array::from_fn(|i| {
+                std::array::from_fn(|k| {
+                    f64::from(u8::from(i == k)) + 0.1 * ((f * 3 + i * 5 + k) as f64).sin()
+                })
+            })
+        })
+        .collect();
+    let weights: Vec<[f64; 3]> =
+        (0..rest.len()).map(|v| [(v as f64).cos(), (2.0 * v as f64).sin(), 0.5]).collect();
+    let loss = |field: &[Jacobian]| -> f64 {
+        let x = solve.solve(&deform(field, &jacobians), p(10));
+        x.iter().zip(&weights).map(|(x, w)| x[0] * w[0] + x[1] * w[1] + x[2] * w[2]).sum()
+    };
+    let grads = deform_backward(&solve.backward(&weights), &jacobians);
+    for f in (0..faces.len()).step_by(11) {
+        for (i, k) in [(0, 0), (1, 2), (2, 1)] {
+            let (mut plus, mut minus) = (field.clone(), field.clone());
+            plus[f][i][k] += 1e-6;
+            minus[f][i][k] -= 1e-6;
+            let fd = (loss(&plus) - loss(&minus)) / 2e-6;
+            assert!(
+                (fd - grads[f][i][k]).abs() < 1e-6 * fd.abs().max(1.0),
+                "face {f}, M[{i}][{k}]: {} vs {fd}",
+                grads[f][i][k]
+            );
+        }
+    }
+}
