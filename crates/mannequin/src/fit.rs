@@ -164,13 +164,7 @@ fn fit_head(body: &BodyModel, image: &Image, landmarks: &PoseLandmarks, focal: f
     if side < MIN_FACE_PX {
         return Ok(Head::Skipped(format!("the face is {side:.0} pixels across, under {MIN_FACE_PX}")));
     }
-    let fitter = FaceFitter::new(
-        &BodyModel::default_body(),
-        &FaceModel::default_face(),
-        image.width,
-        image.height,
-        focal,
-    )?;
+    let fitter = FaceFitter::new(body, &FaceModel::default_face(), image.width, image.height, focal)?;
     Ok(Head::Fitted(Box::new(fitter.fit(&face.landmarks)?)))
 }
 
