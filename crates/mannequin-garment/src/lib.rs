@@ -9,6 +9,7 @@ mod error;
 pub mod file;
 pub mod fit;
 mod garment;
+pub mod jacobian_fit;
 mod layering;
 mod make;
 mod panel;

@@ -67,12 +67,23 @@ impl<'a> Dressed<'a> {
         self.garment.on_body(&points(&self.shaped.vertices), &self.faces)
     }
 
-    /// Eqs. 3.2–3.3: the garment on the body in pose `pose` (3 per joint) moved by `transl`.
-    pub fn posed(&self, pose: &[f32], transl: &[f32]) -> Result<Vec<[f32; 3]>, GarmentError> {
-        let corrected = pose_corrected(self.model, &self.shaped, pose)?;
-        let rest = self.garment.on_body(&points(&corrected), &self.faces);
+    /// `rest` (positions of the garment's vertices on this body at rest, e.g. a reconstruction's)
+    /// posed by linear blend skinning with the garment's weights: each vertex's posed position and
+    /// the 3×3 part of its blended transform, whose transpose carries a gradient back to `rest`.
+    pub fn skin(
+        &self,
+        rest: &[[f32; 3]],
+        pose: &[f32],
+        transl: &[f32],
+    ) -> Result<Vec<([f32; 3], Mat3A)>, GarmentError> {
         let skinning = frame_skinning(self.model, &self.shaped, pose, transl)?;
         let joints = self.model.num_joints();
+        if rest.len() * joints != self.weights.len() {
+            return Err(GarmentError::invalid(
+                "rest",
+                format!("{} vertices; the garment has {}", rest.len(), self.weights.len() / joints.max(1)),
+            ));
+        }
         Ok(rest
             .iter()
             .zip(self.weights.chunks_exact(joints))
@@ -84,8 +95,15 @@ impl<'a> Dressed<'a> {
                         t += skinning[k].translation * wk;
                     }
                 }
-                (m * Vec3A::from(*p) + t).to_array()
+                ((m * Vec3A::from(*p) + t).to_array(), m)
             })
             .collect())
+    }
+
+    /// Eqs. 3.2–3.3: the garment on the body in pose `pose` (3 per joint) moved by `transl`.
+    pub fn posed(&self, pose: &[f32], transl: &[f32]) -> Result<Vec<[f32; 3]>, GarmentError> {
+        let corrected = pose_corrected(self.model, &self.shaped, pose)?;
+        let rest = self.garment.on_body(&points(&corrected), &self.faces);
+        Ok(self.skin(&rest, pose, transl)?.into_iter().map(|(p, _)| p).collect())
     }
 }

@@ -393,7 +393,12 @@ fn read_checkpoint(path: &Path, run: &DressRun, worn: &[Worn]) -> Result<WearPro
 
 /// A `.garment` file, or a category name made at `size` on this body and cached under
 /// `$XDG_CACHE_HOME/mannequin/garments` (or `~/.cache/...`), keyed by everything that made it.
-fn load_or_make(spec: &str, model: &BodyModel, body: &str, size: &str) -> Result<(String, Garment)> {
+pub(crate) fn load_or_make(
+    spec: &str,
+    model: &BodyModel,
+    body: &str,
+    size: &str,
+) -> Result<(String, Garment)> {
     let Ok(category) = Category::named(spec) else {
         let path = Path::new(spec);
         if !path.exists() {

@@ -18,6 +18,10 @@ pub enum GarmentCommand {
     /// Make a garment template on a body (default: the embedded body at rest) and write it as
     /// a .garment file.
     Make(MakeArgs),
+    /// Reconstruct one garment from a dataset's label maps (NGD: a Jacobian field on the
+    /// category's template, fitted through the Poisson solve and the differentiable rasteriser):
+    /// garment.obj and fit.json.
+    Fit(crate::garment_fit::FitArgs),
     /// Summarise a .garment file.
     Info {
         /// The .garment file.
@@ -69,6 +73,7 @@ pub struct MakeArgs {
 pub fn run(cmd: GarmentCommand) -> Result<()> {
     match cmd {
         GarmentCommand::Make(args) => make(args),
+        GarmentCommand::Fit(args) => crate::garment_fit::fit(args),
         GarmentCommand::Info { file, json } => info(&file, json),
     }
 }

@@ -15,6 +15,7 @@ mod face;
 mod face_track;
 mod fit;
 mod garment;
+mod garment_fit;
 mod motion;
 mod pose_choice;
 mod progress;
