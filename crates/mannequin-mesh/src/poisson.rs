@@ -18,7 +18,6 @@ pub struct PoissonSolve {
     /// 3F×V, face-major rows.
     gradient: SparseColMat<usize, f64>,
     areas: Vec<f64>,
-    pinned: usize,
     /// Each vertex's index among the free ones (None for the pinned one).
     slot: Vec<Option<usize>>,
     llt: Llt<usize, f64>,
@@ -62,7 +61,7 @@ impl PoissonSolve {
             .map_err(|e| MeshError::Poisson(format!("{e:?}")))?;
         let llt = free.sp_cholesky(Side::Lower).map_err(|e| MeshError::Poisson(format!("{e:?}")))?;
         let areas = double_areas(rest, faces).into_iter().map(|a| a / 2.0).collect();
-        Ok(Self { gradient: gradient_operator(rest, faces), areas, pinned, slot, llt, coupling })
+        Ok(Self { gradient: gradient_operator(rest, faces), areas, slot, llt, coupling })
     }
 
     /// The positions whose gradients best match `jacobians` (one per face), with the pinned
@@ -71,17 +70,14 @@ impl PoissonSolve {
         let n = self.slot.len();
         // b = Gᵀ A J per coordinate, then b_f − L_fp x_p.
         let mut rhs = Mat::<f64>::zeros(n - 1, 3);
-        let g = self.gradient.as_ref();
-        for v in 0..n {
-            let Some(r) = self.slot[v] else { continue };
-            for (row, value) in g.row_idx_of_col(v).zip(g.val_of_col(v)) {
-                let (f, dim) = (row / 3, row % 3);
-                for d in 0..3 {
-                    rhs[(r, d)] += value * self.areas[f] * jacobians[f][d][dim];
-                }
-            }
+        for (r, f, dim, weight) in self.weighted_gradient() {
             for d in 0..3 {
-                rhs[(r, d)] -= self.coupling[r] * pin[d];
+                rhs[(r, d)] += weight * jacobians[f][d][dim];
+            }
+        }
+        for (r, c) in self.coupling.iter().enumerate() {
+            for d in 0..3 {
+                rhs[(r, d)] -= c * pin[d];
             }
         }
         self.llt.solve_in_place(rhs.as_mut());
@@ -105,21 +101,21 @@ impl PoissonSolve {
         }
         self.llt.solve_in_place(y.as_mut());
         let mut out = vec![[[0.0; 3]; 3]; self.areas.len()];
-        let g = self.gradient.as_ref();
-        for v in 0..n {
-            let Some(r) = self.slot[v] else { continue };
-            for (row, value) in g.row_idx_of_col(v).zip(g.val_of_col(v)) {
-                let (f, dim) = (row / 3, row % 3);
-                for d in 0..3 {
-                    out[f][d][dim] += self.areas[f] * value * y[(r, d)];
-                }
+        for (r, f, dim, weight) in self.weighted_gradient() {
+            for d in 0..3 {
+                out[f][d][dim] += weight * y[(r, d)];
             }
         }
         out
     }
 
-    /// The pinned vertex.
-    pub fn pinned(&self) -> usize {
-        self.pinned
+    /// The entries of A G on the free vertices: (free vertex, face, dimension, A_f G value).
+    fn weighted_gradient(&self) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
+        let g = self.gradient.as_ref();
+        self.slot.iter().enumerate().filter_map(|(v, s)| s.map(|r| (v, r))).flat_map(move |(v, r)| {
+            g.row_idx_of_col(v)
+                .zip(g.val_of_col(v))
+                .map(move |(row, value)| (r, row / 3, row % 3, self.areas[row / 3] * value))
+        })
     }
 }
