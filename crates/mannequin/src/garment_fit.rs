@@ -50,6 +50,10 @@ pub struct FitArgs {
     /// The Jacobian regulariser's weight (toward the base shape).
     #[arg(long, default_value_t = 1e-4)]
     regulariser: f64,
+    /// NGD's vertex noise (Eqs. 11–12): each step's posed vertices move by γ N(0, 1) (1 − e/T)
+    /// at step e of T, so early steps see the garment's overall shape; γ in metres (0: none).
+    #[arg(long, default_value_t = 0.0)]
+    noise: f64,
     /// Images are read at 1/N of their size.
     #[arg(long, default_value_t = 2)]
     downscale: usize,
@@ -106,11 +110,17 @@ pub fn fit(args: FitArgs) -> Result<()> {
     let mut rng = SplitMix64::new(args.seed);
     let progress = bar(args.iters as u64, "garment fit");
     let mut losses = Vec::with_capacity(args.iters);
-    for _ in 0..args.iters {
+    for step in 0..args.iters {
         let k = rng.below(targets.len());
         let (pose, transl) = frame_of(k);
         let rest: Vec<[f32; 3]> = field.positions().iter().map(|p| p.map(|x| x as f32)).collect();
-        let scene = Scene::new(&dressed, &model, &betas, &body_faces, &rest, &pose, &transl)?;
+        let mut scene = Scene::new(&dressed, &model, &betas, &body_faces, &rest, &pose, &transl)?;
+        let scale = args.noise * (1.0 - step as f64 / args.iters as f64);
+        if scale > 0.0 {
+            for p in scene.positions.iter_mut().take(scene.blends.len()) {
+                p.iter_mut().for_each(|c| *c += (scale * rng.normal()) as f32);
+            }
+        }
         let rendered = scene.render(&dataset, targets[k].frame);
         let t = &targets[k];
         let n = t.counts.iter().filter(|c| **c).count().max(1) as f64;
