@@ -51,14 +51,20 @@ pub fn detection_roi(d: &Detection) -> RotatedRect {
 }
 
 impl FaceLandmarks {
-    /// The next video frame's crop from these points (MediaPipe's
-    /// `face_landmark_landmarks_to_roi`): their bounding box, squared on its long side and grown
-    /// 1.5×, levelled by the outer eye corners (points 33 and 263).
-    pub fn next_roi(&self) -> RotatedRect {
+    /// The corners (least and greatest x, y) of the box around the points, in pixels.
+    pub fn bounds(&self) -> ([f32; 2], [f32; 2]) {
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
         for p in &self.points {
             (0..2).for_each(|c| (lo[c], hi[c]) = (lo[c].min(p[c]), hi[c].max(p[c])));
         }
+        (lo, hi)
+    }
+
+    /// The next video frame's crop from these points (MediaPipe's
+    /// `face_landmark_landmarks_to_roi`): their bounding box, squared on its long side and grown
+    /// 1.5×, levelled by the outer eye corners (points 33 and 263).
+    pub fn next_roi(&self) -> RotatedRect {
+        let (lo, hi) = self.bounds();
         let side = ROI_SCALE * (hi[0] - lo[0]).max(hi[1] - lo[1]);
         let eye = |i: usize| [self.points[i][0], self.points[i][1]];
         RotatedRect {

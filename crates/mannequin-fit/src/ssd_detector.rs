@@ -43,6 +43,11 @@ pub struct Detection {
 }
 
 impl Detection {
+    /// The box's long side: how large the object is in the picture.
+    pub fn side(&self) -> f32 {
+        (self.bbox[2] - self.bbox[0]).max(self.bbox[3] - self.bbox[1])
+    }
+
     pub fn area(&self) -> f32 {
         (self.bbox[2] - self.bbox[0]).max(0.0) * (self.bbox[3] - self.bbox[1]).max(0.0)
     }

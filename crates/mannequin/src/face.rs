@@ -65,8 +65,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
             args.image.display()
         );
     };
-    let side = (face.detection.bbox[2] - face.detection.bbox[0])
-        .max(face.detection.bbox[3] - face.detection.bbox[1]);
+    let side = face.detection.side();
     if side < MIN_FACE_PX {
         bail!(
             "{}: the face is {side:.0} pixels across; fitting needs at least {MIN_FACE_PX}",
@@ -126,20 +125,22 @@ pub(crate) fn head_mesh(
     face: &FaceModel,
     views: &[(&FaceFit, &Image)],
 ) -> Result<(TriMesh, Texture)> {
-    let (shown, _) = views.first().context("a head needs at least one view to be coloured from")?;
-    let mut head = fitted_head(body, face, shown)?;
-    let placed = views
+    if views.is_empty() {
+        bail!("a head needs at least one view to be coloured from");
+    }
+    let heads = views.iter().map(|(fit, _)| fitted_head(body, face, fit)).collect::<Result<Vec<_>>>()?;
+    let placed: Vec<Vec<DVec3>> = heads
         .iter()
-        .map(|(fit, _)| {
-            Ok(fitted_head(body, face, fit)?.positions.iter().map(|p| fit.to_camera(*p)).collect())
-        })
-        .collect::<Result<Vec<Vec<DVec3>>>>()?;
+        .zip(views)
+        .map(|(head, (fit, _))| head.positions.iter().map(|p| fit.to_camera(*p)).collect())
+        .collect();
     let pictures: Vec<View> = placed
         .iter()
         .zip(views)
         .map(|(points, (fit, image))| View { points, camera: &fit.camera, image })
         .collect();
     let rest: Vec<[f32; 3]> = face.vertices.iter().map(|&v| body.v_template[v]).collect();
+    let mut head = heads.into_iter().next().expect("one head per view");
     let texture = fit_texture(&pictures, &head.faces, &mirror_vertices(&rest))?;
     head.colors = Some(texture.albedo.clone());
     Ok((head, texture))

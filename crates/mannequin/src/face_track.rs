@@ -254,10 +254,7 @@ fn track_frames(args: &FaceTrackArgs, frames: &Frames, start: Instant) -> Result
 
 /// The long side of the box around a face's points, in pixels.
 fn face_side(landmarks: &FaceLandmarks) -> f32 {
-    let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
-    for p in &landmarks.points {
-        (0..2).for_each(|c| (lo[c], hi[c]) = (lo[c].min(p[c]), hi[c].max(p[c])));
-    }
+    let (lo, hi) = landmarks.bounds();
     (hi[0] - lo[0]).max(hi[1] - lo[1])
 }
 

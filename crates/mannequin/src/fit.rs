@@ -91,13 +91,14 @@ pub fn run(args: Args) -> Result<()> {
     let focal = args.fitting.focal(image.width, image.height);
     let fit = fit_body(&model, &landmarks, image.width, image.height, focal)
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
-    let head = match args.no_face || args.fitting.body != "default" {
-        true => Head::NotAsked,
-        false => fit_head(&model, &image, &landmarks, focal)
+    let face_model = (!args.no_face && args.fitting.body == "default").then(FaceModel::default_face);
+    let head = match &face_model {
+        None => Head::NotAsked,
+        Some(face_model) => fit_head(&model, face_model, &image, &landmarks, focal)
             .with_context(|| format!("fitting the face in {}", args.image.display()))?,
     };
-    let model = match &head {
-        Head::Fitted(face) => with_head(model, face)?,
+    let model = match (&head, &face_model) {
+        (Head::Fitted(face), Some(face_model)) => with_head(model, face_model, face)?,
         _ => model,
     };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
@@ -150,7 +151,13 @@ impl Head {
 
 /// The face (thesis §2.3) of the person whose body was fitted: the largest face whose box holds
 /// the body's nose landmark, when it is large enough to fit.
-fn fit_head(body: &BodyModel, image: &Image, landmarks: &PoseLandmarks, focal: f64) -> Result<Head> {
+fn fit_head(
+    body: &BodyModel,
+    face_model: &FaceModel,
+    image: &Image,
+    landmarks: &PoseLandmarks,
+    focal: f64,
+) -> Result<Head> {
     let nose = landmarks.points[0];
     let faces = FaceModels::load()?.faces(image)?;
     let Some(face) = faces.into_iter().find(|f| {
@@ -159,19 +166,18 @@ fn fit_head(body: &BodyModel, image: &Image, landmarks: &PoseLandmarks, focal: f
     }) else {
         return Ok(Head::Skipped("no face found at the person's head".into()));
     };
-    let [x0, y0, x1, y1] = face.detection.bbox;
-    let side = (x1 - x0).max(y1 - y0);
+    let side = face.detection.side();
     if side < MIN_FACE_PX {
         return Ok(Head::Skipped(format!("the face is {side:.0} pixels across, under {MIN_FACE_PX}")));
     }
-    let fitter = FaceFitter::new(body, &FaceModel::default_face(), image.width, image.height, focal)?;
+    let fitter = FaceFitter::new(body, face_model, image.width, image.height, focal)?;
     Ok(Head::Fitted(Box::new(fitter.fit(&face.landmarks)?)))
 }
 
 /// The default body with the fitted face's shape and expression on its head: every output
 /// (meshes, skinned glTF) then carries the head.
-fn with_head(mut model: BodyModel, face: &FaceFit) -> Result<BodyModel> {
-    FaceModel::default_face().apply(&mut model.v_template, &face.shape, &face.expression)?;
+fn with_head(mut model: BodyModel, face_model: &FaceModel, face: &FaceFit) -> Result<BodyModel> {
+    face_model.apply(&mut model.v_template, &face.shape, &face.expression)?;
     Ok(model)
 }
 
