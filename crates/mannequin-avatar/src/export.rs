@@ -3,6 +3,7 @@
 //! colour, and the personalised mesh skinned for glTF.
 
 use mannequin_mesh::TriMesh;
+use mannequin_mesh::gltf::influences::top_four;
 use mannequin_mesh::gltf::{Skeleton, SkinnedMesh};
 use mannequin_splat::{SplatScene, sh};
 
@@ -139,6 +140,54 @@ impl Binding {
             Method::Ihuman => Self { per_face: true, per_vertex: false },
         }
     }
+}
+
+/// Four joint indices and their weights.
+pub type Influences = ([u16; 4], [f32; 4]);
+
+/// The linear-blend skinning of each of the avatar's Gaussians, in their order ([`Binding`]):
+/// a face Gaussian takes the mean of its face's three vertex weight rows (it sits at the
+/// centroid, which the face's vertices carry), a vertex Gaussian its vertex's row; each keeps
+/// its four largest weights, renormalised, as glTF's JOINTS_0/WEIGHTS_0 do. A viewer moving the
+/// canonical Gaussians by these weights approximates the binding: exact for rigid parts, and off
+/// where a triangle bends across a joint.
+pub fn gaussian_skinning(avatar: &Avatar) -> Result<Vec<Influences>, AvatarError> {
+    let c = &avatar.canonical;
+    let (v, j) = (c.num_vertices(), c.num_joints());
+    if c.weights.len() != v * j {
+        return Err(AvatarError::Invalid(format!(
+            "{} skinning weights for {v} vertices × {j} joints",
+            c.weights.len()
+        )));
+    }
+    let row = |i: u32| &c.weights[i as usize * j..(i as usize + 1) * j];
+    let binding = Binding::of(avatar);
+    let faces = c.faces.iter().filter(|_| binding.per_face).map(|f| {
+        let mean: Vec<f32> = (0..j).map(|k| f.iter().map(|&i| row(i)[k]).sum::<f32>() / 3.0).collect();
+        top_four(&mean)
+    });
+    let vertices = (0..v as u32).filter(|_| binding.per_vertex).map(|i| top_four(row(i)));
+    faces
+        .chain(vertices)
+        .enumerate()
+        .map(|(g, w)| {
+            w.ok_or_else(|| AvatarError::Invalid(format!("Gaussian {g} has no positive skinning weight")))
+        })
+        .collect()
+}
+
+/// The avatar's Gaussians at the canonical pose (`canonical`, posed with zero rotations) with
+/// their [`gaussian_skinning`] as the extra float vertex properties `joint_0..3` (joint indices)
+/// and `weight_0..3` that animated-splat viewers read (docs/viewer.md), as `.ply` bytes.
+pub fn skinned_gaussians_ply(avatar: &Avatar, canonical: &Posed) -> Result<Vec<u8>, AvatarError> {
+    let scene = gaussian_scene(avatar, &canonical.gaussians)?;
+    let skin = gaussian_skinning(avatar)?;
+    let columns: Vec<(String, Vec<f32>)> = (0..4)
+        .map(|k| (format!("joint_{k}"), skin.iter().map(|(j, _)| f32::from(j[k])).collect()))
+        .chain((0..4).map(|k| (format!("weight_{k}"), skin.iter().map(|(_, w)| w[k]).collect())))
+        .collect();
+    let extra: Vec<(&str, &[f32])> = columns.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    Ok(scene.ply_bytes(&extra)?)
 }
 
 /// Running sums over a vertex's faces: Σ A·rgb, Σ A, Σ rgb and their count.

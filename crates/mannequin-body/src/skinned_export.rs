@@ -25,22 +25,22 @@ pub fn skinned_body(model: &BodyModel, shape: &[f32]) -> Result<SkinnedMesh, Bod
     })
 }
 
-/// F frames of axis-angle `poses` (F × 3J, the model's layout) and `trans` (F × 3) at `fps`.
+/// F frames of axis-angle `poses` (F × 3J for a skeleton of `joints` joints, SMPL's layout) and
+/// `trans` (F × 3) at `fps`.
 pub fn skeletal_animation(
-    model: &BodyModel,
+    joints: usize,
     poses: &[f32],
     trans: &[f32],
     fps: f32,
 ) -> Result<SkeletalAnimation, BodyError> {
-    let pl = model.pose_len();
-    if !poses.len().is_multiple_of(pl) || poses.len() / pl != trans.len() / 3 {
+    let pl = 3 * joints;
+    if pl == 0 || !poses.len().is_multiple_of(pl) || poses.len() / pl != trans.len() / 3 {
         return Err(BodyError::input(
             "motion",
             format!(
-                "{} pose values and {} translations do not make whole frames of {} joints",
+                "{} pose values and {} translations do not make whole frames of {joints} joints",
                 poses.len(),
                 trans.len() / 3,
-                model.num_joints()
             ),
         ));
     }

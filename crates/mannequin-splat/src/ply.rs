@@ -4,6 +4,7 @@
 //! logit, `scale_0..2` as natural logs, and `rot_0..3` as a `(w, x, y, z)` quaternion.
 //! Binary (either endianness) and ASCII files are read; binary little-endian is written.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use mannequin_io::ply_header::{Element, Property};
@@ -156,7 +157,29 @@ impl SplatScene {
 
     /// Writes the scene as a binary little-endian INRIA `.ply`, atomically.
     pub fn write_ply(&self, path: impl AsRef<Path>) -> Result<(), SplatError> {
+        self.write_ply_with(path, &[])
+    }
+
+    /// [`Self::write_ply`] with `extra` per-splat float properties (name, one value per splat)
+    /// after the INRIA ones, such as the skinning of animated splats; viewers skip what they do
+    /// not know.
+    pub fn write_ply_with(&self, path: impl AsRef<Path>, extra: &[(&str, &[f32])]) -> Result<(), SplatError> {
         let path = path.as_ref();
+        self.check_ply(extra)?;
+        mannequin_io::write_atomic_with(path, |w| self.encode_ply(w, extra))
+            .map_err(|source| SplatError::Io { path: path.to_path_buf(), source })
+    }
+
+    /// The bytes [`Self::write_ply_with`] writes, for a server that sends them instead.
+    pub fn ply_bytes(&self, extra: &[(&str, &[f32])]) -> Result<Vec<u8>, SplatError> {
+        self.check_ply(extra)?;
+        let mut bytes = Vec::new();
+        self.encode_ply(&mut bytes, extra)
+            .map_err(|source| SplatError::Io { path: "<memory>".into(), source })?;
+        Ok(bytes)
+    }
+
+    fn check_ply(&self, extra: &[(&str, &[f32])]) -> Result<(), SplatError> {
         let n = self.len();
         let k = sh::basis_len(self.sh_degree);
         let expect = |field: &'static str, len: usize, per: usize| {
@@ -170,6 +193,15 @@ impl SplatScene {
         expect("quaternions", self.quaternions.len(), 4)?;
         expect("scales", self.scales.len(), 3)?;
         expect("SH coefficients", self.sh.len(), 3 * k)?;
+        for (_, values) in extra {
+            expect("extra property", values.len(), 1)?;
+        }
+        Ok(())
+    }
+
+    fn encode_ply(&self, w: &mut dyn Write, extra: &[(&str, &[f32])]) -> std::io::Result<()> {
+        let n = self.len();
+        let k = sh::basis_len(self.sh_degree);
         let mut header = format!("ply\nformat binary_little_endian 1.0\nelement vertex {n}\n");
         let mut names: Vec<String> =
             ["x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"].map(String::from).to_vec();
@@ -178,34 +210,33 @@ impl SplatScene {
             ["opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"]
                 .map(String::from),
         );
+        names.extend(extra.iter().map(|(name, _)| name.to_string()));
         for name in &names {
             header.push_str(&format!("property float {name}\n"));
         }
         header.push_str("end_header\n");
         let mut record = Vec::with_capacity(names.len());
-        mannequin_io::write_atomic_with(path, |w| {
-            w.write_all(header.as_bytes())?;
-            for i in 0..n {
-                record.clear();
-                record.extend_from_slice(&self.means[3 * i..3 * i + 3]);
-                record.extend([0.0; 3]);
-                let c = &self.sh[3 * k * i..3 * k * (i + 1)];
-                record.extend_from_slice(&c[..3]);
-                for ch in 0..3 {
-                    record.extend((1..k).map(|b| c[3 * b + ch]));
-                }
-                // Keep the logit finite for opacities of exactly 0 or 1.
-                let o = (self.opacities[i] as f64).clamp(1e-7, 1.0 - 1e-7);
-                record.push((o / (1.0 - o)).ln() as f32);
-                record.extend(self.scales[3 * i..3 * i + 3].iter().map(|s| s.ln()));
-                record.extend_from_slice(&self.quaternions[4 * i..4 * i + 4]);
-                for v in &record {
-                    w.write_all(&v.to_le_bytes())?;
-                }
+        w.write_all(header.as_bytes())?;
+        for i in 0..n {
+            record.clear();
+            record.extend_from_slice(&self.means[3 * i..3 * i + 3]);
+            record.extend([0.0; 3]);
+            let c = &self.sh[3 * k * i..3 * k * (i + 1)];
+            record.extend_from_slice(&c[..3]);
+            for ch in 0..3 {
+                record.extend((1..k).map(|b| c[3 * b + ch]));
             }
-            Ok(())
-        })
-        .map_err(|source| SplatError::Io { path: path.to_path_buf(), source })
+            // Keep the logit finite for opacities of exactly 0 or 1.
+            let o = (self.opacities[i] as f64).clamp(1e-7, 1.0 - 1e-7);
+            record.push((o / (1.0 - o)).ln() as f32);
+            record.extend(self.scales[3 * i..3 * i + 3].iter().map(|s| s.ln()));
+            record.extend_from_slice(&self.quaternions[4 * i..4 * i + 4]);
+            record.extend(extra.iter().map(|(_, values)| values[i]));
+            for v in &record {
+                w.write_all(&v.to_le_bytes())?;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -189,7 +189,7 @@ fn animate(args: AnimateArgs) -> Result<()> {
     let model = load_body(&args.body.body)?;
     let poses = motion.poses_for(&model)?;
     let skinned = skinned_body(&model, &args.body.betas)?;
-    let animation = skeletal_animation(&model, &poses, &motion.trans, motion.fps)?;
+    let animation = skeletal_animation(model.num_joints(), &poses, &motion.trans, motion.fps)?;
     mannequin_mesh::gltf::write_glb(&args.output, &skinned, Some(&animation))
         .with_context(|| format!("writing {}", args.output.display()))?;
     tracing::info!(

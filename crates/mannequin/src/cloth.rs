@@ -342,7 +342,8 @@ fn write_outputs(
     let skinned = skinned_body(model, betas)?;
     let poses = motion.poses_for(model)?;
     let pl = model.pose_len();
-    let animation = skeletal_animation(model, &poses[..f * pl], &motion.trans[..3 * f], motion.fps)?;
+    let animation =
+        skeletal_animation(model.num_joints(), &poses[..f * pl], &motion.trans[..3 * f], motion.fps)?;
     let mut mesh = garment.clone();
     mesh.positions = frames[0].clone();
     let cache = MorphSequence { name: "garment".into(), mesh, frames: frames.clone(), fps: motion.fps };

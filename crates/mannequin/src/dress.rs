@@ -471,7 +471,8 @@ fn write_scene(
     let skinned = skinned_body(model, betas)?;
     let poses = motion.poses_for(model)?;
     let pl = model.pose_len();
-    let animation = skeletal_animation(model, &poses[..f * pl], &motion.trans[..3 * f], motion.fps)?;
+    let animation =
+        skeletal_animation(model.num_joints(), &poses[..f * pl], &motion.trans[..3 * f], motion.fps)?;
     write_scene_glb(dir.join("dressed.glb"), &skinned, Some(&animation), &morphs)?;
     Ok(())
 }

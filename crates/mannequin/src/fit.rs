@@ -237,7 +237,7 @@ fn write_body_npz(path: &Path, fit: &BodyFit, head: &Head) -> Result<()> {
 /// The shaped body, skinned, holding the fitted pose as a one-frame animation.
 fn write_glb(path: &Path, model: &BodyModel, fit: &BodyFit) -> Result<()> {
     let skinned = skinned_body(model, &fit.betas)?;
-    let animation = skeletal_animation(model, &fit.pose, &fit.transl, 30.0)?;
+    let animation = skeletal_animation(model.num_joints(), &fit.pose, &fit.transl, 30.0)?;
     mannequin_mesh::gltf::write_glb(path, &skinned, Some(&animation))
         .with_context(|| format!("writing {}", path.display()))
 }

@@ -24,6 +24,7 @@ mod splat;
 mod synth;
 mod train;
 mod video_input;
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -84,6 +85,9 @@ enum Command {
     /// Export a trained avatar: its mesh (.obj/.ply, canonical or posed), a skinned coloured .glb,
     /// or its Gaussians at a pose as a 3DGS .ply.
     Export(export::Args),
+    /// Look at an avatar (its Gaussians animated), a dressed body, a cloth simulation, a .glb or a
+    /// 3DGS .ply in the browser: a local server on 127.0.0.1 with an embedded page.
+    View(view::Args),
 }
 
 /// Runs one verb; the demo chains several through here.
@@ -95,6 +99,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Dress(args) => dress::run(args),
         Command::Capture(args) => capture::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::View(args) => view::run(args),
         Command::Face(cmd) => face::run(cmd),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),

@@ -43,15 +43,26 @@ pub fn write_scene_glb(
     morphs: &[MorphSequence],
 ) -> Result<(), MeshFileError> {
     let path = path.as_ref();
-    skinned.validate(path)?;
+    let bytes = scene_glb_bytes(path, skinned, animation, morphs)?;
+    mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
+}
+
+/// The bytes [`write_scene_glb`] writes, for a server that sends them instead; `name` names the
+/// file in errors.
+pub fn scene_glb_bytes(
+    name: &Path,
+    skinned: &SkinnedMesh,
+    animation: Option<&SkeletalAnimation>,
+    morphs: &[MorphSequence],
+) -> Result<Vec<u8>, MeshFileError> {
+    skinned.validate(name)?;
     if let Some(a) = animation {
-        a.validate(path, skinned.skeleton.joint_count())?;
+        a.validate(name, skinned.skeleton.joint_count())?;
     }
     for m in morphs {
-        m.validate(path)?;
+        m.validate(name)?;
     }
-    let bytes = encode(path, skinned, animation, morphs)?;
-    mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
+    encode(name, skinned, animation, morphs)
 }
 
 fn encode(

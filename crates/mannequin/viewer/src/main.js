@@ -1,0 +1,263 @@
+// The page `mannequin view` serves: the layers listed in /scene.json (skinned glTF meshes with
+// their animation, cloth caches as morph targets, Gaussian splats, splats skinned to a glTF
+// skeleton) on one timeline. Query parameters, for reproducible screenshots:
+//   camera=<camera JSON, as `splat render --camera` reads it>  fixes the view and canvas size
+//   t=<seconds>  starts paused at that time;  bg=<CSS colour>;  ui=0 hides the panel.
+// window.mannequin exposes ready, frames (drawn so far), fps, duration, setTime(t) and
+// setBackground(colour) to tests and benchmarks.
+import * as THREE from "three";
+import { OrbitControls } from "three/addons/controls/OrbitControls.js";
+import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
+import { SparkRenderer, SplatMesh, SplatSkinning } from "@sparkjsdev/spark";
+import { readSkinning } from "./splat_skinning.js";
+import { cameraFromOpenCv } from "./opencv_camera.js";
+
+const params = new URLSearchParams(location.search);
+const $ = (id) => document.getElementById(id);
+const status = { ready: false, frames: 0, duration: 0, time: 0, layers: [] };
+window.mannequin = status;
+
+function fail(message) {
+  $("error").textContent += `${message}\n`;
+  console.error(message);
+}
+
+const canvas = $("view");
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(1);
+const scene = new THREE.Scene();
+scene.add(new THREE.HemisphereLight(0xffffff, 0x505060, 2.0));
+const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+sun.position.set(-1, 2, 3);
+scene.add(sun);
+const spark = new SparkRenderer({ renderer });
+scene.add(spark);
+
+const background = params.get("bg") ?? "#20242a";
+scene.background = new THREE.Color(background);
+document.body.style.setProperty("--background", background);
+if (params.get("ui") === "0") document.body.classList.add("bare");
+
+// The view: a fixed OpenCV camera from the query, else a perspective camera orbiting the scene.
+let camera;
+let controls = null;
+const fixed = params.get("camera");
+if (fixed) {
+  const c = cameraFromOpenCv(JSON.parse(fixed));
+  camera = c.camera;
+  renderer.setSize(c.width, c.height, true);
+} else {
+  camera = new THREE.PerspectiveCamera(35, 1, 0.01, 100);
+  camera.position.set(0, 0.2, 4);
+  controls = new OrbitControls(camera, canvas);
+  controls.enablePan = true;
+  const resize = () => {
+    renderer.setSize(window.innerWidth, window.innerHeight, true);
+    camera.aspect = window.innerWidth / window.innerHeight;
+    camera.updateProjectionMatrix();
+  };
+  window.addEventListener("resize", resize);
+  resize();
+}
+
+// The timeline: one clock for every layer's animation.
+const mixers = [];
+const skinnedSplats = [];
+let playing = !params.has("t");
+let time = Number(params.get("t") ?? 0);
+let speed = 1;
+$("play").textContent = playing ? "Pause" : "Play";
+$("play").onclick = () => {
+  playing = !playing;
+  $("play").textContent = playing ? "Pause" : "Play";
+};
+$("speed").onchange = (e) => {
+  speed = Number(e.target.value);
+};
+$("timeline").oninput = (e) => {
+  playing = false;
+  $("play").textContent = "Play";
+  setTime(Number(e.target.value) * status.duration);
+};
+
+function setTime(t) {
+  time = status.duration > 0 ? ((t % status.duration) + status.duration) % status.duration : 0;
+  status.time = time;
+  for (const mixer of mixers) mixer.setTime(time);
+  scene.updateMatrixWorld(true);
+  for (const s of skinnedSplats) s.update();
+  $("timeline").value = status.duration > 0 ? time / status.duration : 0;
+  $("clock").textContent = `${time.toFixed(2)} s`;
+}
+status.setTime = setTime;
+status.setBackground = (colour) => {
+  scene.background = new THREE.Color(colour);
+};
+
+function addToggle(name, object) {
+  const label = document.createElement("label");
+  const box = document.createElement("input");
+  box.type = "checkbox";
+  box.checked = object.visible;
+  box.onchange = () => {
+    object.visible = box.checked;
+  };
+  label.append(box, ` ${name}`);
+  $("layers").append(label);
+  status.layers.push(name);
+}
+
+async function loadGltf(layer) {
+  const gltf = await new GLTFLoader().loadAsync(layer.url);
+  const root = gltf.scene;
+  scene.add(root);
+  root.traverse((o) => {
+    if (o.isMesh) {
+      o.frustumCulled = false;
+      o.visible = layer.visible !== false;
+      addToggle(o.name || layer.name, o);
+    }
+  });
+  const skinned = [];
+  root.traverse((o) => o.isSkinnedMesh && skinned.push(o));
+  if (skinned.length > 0) {
+    const helper = new THREE.SkeletonHelper(root);
+    helper.visible = false;
+    scene.add(helper);
+    addToggle(`${layer.name} skeleton`, helper);
+  }
+  if (gltf.animations.length > 0) {
+    const mixer = new THREE.AnimationMixer(root);
+    for (const clip of gltf.animations) mixer.clipAction(clip).play();
+    mixers.push(mixer);
+    status.duration = Math.max(status.duration, ...gltf.animations.map((c) => c.duration));
+  }
+  return { root, skeleton: skinned[0]?.skeleton ?? null };
+}
+
+// Splats skinned to a glTF skeleton: each splat moves by S_k = bone_k.matrixWorld · boneInverse_k
+// (the matrix three.js skins the mesh's vertices with), blended over its four weights as dual
+// quaternions (Spark's linear blending needs its covariance splats, which fail to load .ply).
+// S_k is rigid: Mannequin's bind pose has identity rotations and no scale.
+async function loadSplats(layer, skeletons) {
+  const bytes = new Uint8Array(await (await fetch(layer.url)).arrayBuffer());
+  const splats = new SplatMesh({ fileBytes: bytes.slice(), fileType: "ply" });
+  await splats.initialized;
+  scene.add(splats);
+  addToggle(layer.name, splats);
+  if (!layer.skeleton) return;
+  const skeleton = skeletons.get(layer.skeleton);
+  if (!skeleton) throw new Error(`${layer.url}: no skinned mesh in layer '${layer.skeleton}' to follow`);
+  const skin = readSkinning(bytes, layer.url);
+  const bones = skeleton.bones.length;
+  const skinning = new SplatSkinning({ mesh: splats, numSplats: skin.count, numBones: bones });
+  const [q, p, scale] = [new THREE.Quaternion(), new THREE.Vector3(), new THREE.Vector3()];
+  for (let k = 0; k < bones; k++) skinning.setRestQuatPos(k, q, p);
+  const j = new THREE.Vector4();
+  const w = new THREE.Vector4();
+  for (let i = 0; i < skin.count; i++) {
+    j.fromArray(skin.joints, 4 * i);
+    w.fromArray(skin.weights, 4 * i);
+    skinning.setSplatBones(i, j, w);
+  }
+  splats.skinning = skinning;
+  splats.updateGenerator();
+  const m = new THREE.Matrix4();
+  skinnedSplats.push({
+    update() {
+      for (let k = 0; k < bones; k++) {
+        m.multiplyMatrices(skeleton.bones[k].matrixWorld, skeleton.boneInverses[k]);
+        m.decompose(p, q, scale);
+        skinning.setBoneQuatPos(k, q, p);
+      }
+      skinning.updateBones();
+    },
+  });
+}
+
+async function load() {
+  const manifest = await (await fetch("/scene.json")).json();
+  $("title").textContent = manifest.title;
+  document.title = `${manifest.title} · Mannequin`;
+  const skeletons = new Map();
+  for (const layer of manifest.layers.filter((l) => l.kind === "glb")) {
+    const { skeleton } = await loadGltf(layer);
+    if (skeleton) skeletons.set(layer.name, skeleton);
+  }
+  for (const layer of manifest.layers.filter((l) => l.kind === "splats")) await loadSplats(layer, skeletons);
+  if (manifest.compare) showCompare(manifest.compare);
+  if (controls) frameScene();
+  setTime(time);
+  const parts = manifest.layers.map((l) => `${l.name} (${l.kind})`).join(", ");
+  $("status").textContent = `${parts}\n${status.duration.toFixed(2)} s of motion`;
+}
+
+// Points the orbiting camera at everything loaded, from the front (+z), whole body in view.
+function frameScene() {
+  const box = new THREE.Box3().setFromObject(scene, true);
+  if (box.isEmpty()) return;
+  const centre = box.getCenter(new THREE.Vector3());
+  const size = box.getSize(new THREE.Vector3()).length();
+  controls.target.copy(centre);
+  camera.position.set(centre.x, centre.y, centre.z + 1.6 * size);
+  controls.update();
+}
+
+// A test view beside its ground truth, for an avatar folder with its dataset.
+function showCompare(compare) {
+  const box = $("compare");
+  for (const [label, url] of [["render", compare.render], ["ground truth", compare.truth]]) {
+    const img = document.createElement("img");
+    img.src = url;
+    img.alt = label;
+    img.title = label;
+    box.append(img);
+  }
+  box.style.display = "block";
+}
+
+// Files dropped on the page: a .glb (its animation joins the timeline) or a 3DGS .ply.
+document.addEventListener("dragover", (e) => e.preventDefault());
+document.addEventListener("drop", async (e) => {
+  e.preventDefault();
+  for (const file of e.dataTransfer.files) {
+    const url = URL.createObjectURL(file);
+    const name = file.name;
+    try {
+      if (name.toLowerCase().endsWith(".glb")) await loadGltf({ name, url, kind: "glb" });
+      else if (name.toLowerCase().endsWith(".ply")) await loadSplats({ name, url, kind: "splats" }, new Map());
+      else fail(`${name}: expected a .glb or a 3DGS .ply`);
+      setTime(time);
+    } catch (err) {
+      fail(`${name}: ${err.message}`);
+    }
+  }
+});
+
+let last = performance.now();
+let fpsFrames = 0;
+let fpsStart = last;
+function frame(now) {
+  const dt = Math.min((now - last) / 1000, 0.1);
+  last = now;
+  if (playing && status.duration > 0) setTime(time + dt * speed);
+  controls?.update();
+  renderer.render(scene, camera);
+  status.frames += 1;
+  fpsFrames += 1;
+  if (now - fpsStart > 1000) {
+    status.fps = (1000 * fpsFrames) / (now - fpsStart);
+    $("fps").textContent = `${status.fps.toFixed(1)} frames/s`;
+    fpsFrames = 0;
+    fpsStart = now;
+  }
+  requestAnimationFrame(frame);
+}
+
+load()
+  .then(() => {
+    status.ready = true;
+    document.body.dataset.ready = "1";
+    requestAnimationFrame(frame);
+  })
+  .catch((err) => fail(`loading the scene: ${err.message}`));
