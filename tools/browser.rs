@@ -17,6 +17,12 @@ use serde_json::{Value, json};
 /// Where Debian's package puts it; `CHROMIUM` overrides.
 const CHROMIUM: &str = "/usr/bin/chromium";
 
+/// WebGL on the CPU through Mesa's llvmpipe (EGL, no display needed): ten times the frame rate
+/// of Chromium's own SwiftShader on the viewer's splats (docs/viewer.md). `CHROMIUM_FLAGS`
+/// replaces these: `--use-angle=swiftshader --enable-unsafe-swiftshader` for SwiftShader, or
+/// `--use-angle=vulkan` for a real GPU.
+const SOFTWARE_WEBGL: &str = "--use-angle=gl-egl --ignore-gpu-blocklist";
+
 pub struct Browser {
     child: Child,
     to: ChildStdin,
@@ -62,8 +68,6 @@ impl Browser {
             .args([
                 "--headless",
                 "--no-sandbox",
-                "--use-angle=swiftshader",
-                "--enable-unsafe-swiftshader",
                 "--disable-quic",
                 "--no-first-run",
                 "--disable-background-networking",
@@ -76,6 +80,9 @@ impl Browser {
                 &format!("--window-size={width},{height}"),
                 "about:blank",
             ])
+            .args(
+                std::env::var("CHROMIUM_FLAGS").unwrap_or_else(|_| SOFTWARE_WEBGL.into()).split_whitespace(),
+            )
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(log)

@@ -8,14 +8,16 @@ use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
 use mannequin_avatar::params::host_rows;
 use mannequin_avatar::{Avatar, Posed, export};
+use mannequin_body::{Motion, skeletal_animation};
 use mannequin_mesh::TriMesh;
+use mannequin_mesh::gltf::SkeletalAnimation;
 
 use crate::body::write_mesh;
 use crate::pose_choice::PoseChoice;
 use crate::progress::JobTimer;
 
 #[derive(clap::Args)]
-#[command(group = clap::ArgGroup::new("outputs").required(true).multiple(true).args(["output", "gaussians"]))]
+#[command(group = clap::ArgGroup::new("outputs").required(true).multiple(true).args(["output", "gaussians", "skinned_gaussians"]))]
 pub struct Args {
     /// Trained avatar folder (written by `mannequin train`).
     #[arg(long)]
@@ -32,6 +34,14 @@ pub struct Args {
     /// The Gaussians at the pose as a 3DGS `.ply` in the INRIA layout, for splat viewers.
     #[arg(long)]
     gaussians: Option<PathBuf>,
+    /// With a `.glb` output: this motion (AMASS or PeopleSnapshot `.npz`) as its animation.
+    #[arg(long, requires = "output")]
+    animation: Option<PathBuf>,
+    /// The Gaussians at the canonical pose as a 3DGS `.ply` with their skinning (per-splat
+    /// joint_0..3 and weight_0..3; docs/viewer.md), for viewers that animate splats with the
+    /// `.glb`'s skeleton, such as `mannequin view`.
+    #[arg(long)]
+    skinned_gaussians: Option<PathBuf>,
 }
 
 /// Whether `-o` names a skinned `.glb` (else `.obj` or `.ply`; anything else is an error).
@@ -45,16 +55,35 @@ fn is_glb(path: &Path) -> Result<bool> {
 
 /// Writes the mesh: skinned `.glb` at the bind pose, or `.obj`/`.ply` at the pose (V_s exactly
 /// when `canonical`); each with vertex colour baked from the Gaussians.
-fn write_output(avatar: &Avatar, posed: &Posed, canonical: bool, glb: bool, output: &Path) -> Result<()> {
-    if glb {
+fn write_output(
+    avatar: &Avatar,
+    posed: &Posed,
+    canonical: bool,
+    glb: Option<Option<&Motion>>,
+    output: &Path,
+) -> Result<()> {
+    if let Some(motion) = glb {
         let skinned = export::skinned_mesh(avatar, posed)?;
-        return mannequin_mesh::gltf::write_glb(output, &skinned, None)
+        let animation = motion.map(|m| avatar_animation(avatar, m)).transpose()?;
+        return mannequin_mesh::gltf::write_glb(output, &skinned, animation.as_ref())
             .with_context(|| format!("writing {}", output.display()));
     }
     let vertices = if canonical { &posed.personalised } else { &posed.vertices };
     let mut mesh = TriMesh::new(host_rows(vertices.clone()), avatar.canonical.faces.clone());
     mesh.colors = Some(export::vertex_colours(avatar, posed)?);
     write_mesh(output, &mesh)
+}
+
+/// `motion` as an animation of the avatar's glTF skeleton ([`export::skinned_mesh`]).
+pub fn avatar_animation(avatar: &Avatar, motion: &Motion) -> Result<SkeletalAnimation> {
+    let j = avatar.canonical.num_joints();
+    let poses = motion.poses_for_joints(j)?;
+    Ok(skeletal_animation(j, &poses, &motion.trans, motion.fps)?)
+}
+
+/// The avatar at its canonical pose (zero rotations, no translation): the glTF bind pose.
+pub fn canonical_pose(avatar: &Avatar) -> Result<Posed> {
+    Ok(avatar.pose(&vec![0.0; 3 * avatar.canonical.num_joints()], [0.0; 3])?)
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -69,22 +98,31 @@ pub fn run(args: Args) -> Result<()> {
             output.display()
         );
     }
-    if let Some(path) =
-        args.gaussians.as_deref().filter(|p| !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
-    {
-        bail!("{}: Gaussians are written as a 3DGS .ply; use a .ply extension", path.display());
+    if let (Some(path), Some(false)) = (&args.animation, glb) {
+        bail!("{}: --animation goes into a .glb output", path.display());
     }
+    for path in [&args.gaussians, &args.skinned_gaussians].into_iter().flatten() {
+        if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")) {
+            bail!("{}: Gaussians are written as a 3DGS .ply; use a .ply extension", path.display());
+        }
+    }
+    let motion = args.animation.as_deref().map(Motion::read).transpose()?;
     let avatar = Avatar::load(&args.avatar, &Device::flex())?;
     let (pose, transl) = args.pose.resolve(avatar.canonical.num_joints())?;
     let posed = avatar.pose(&pose, transl)?;
     if let (Some(output), Some(glb)) = (&args.output, glb) {
-        write_output(&avatar, &posed, args.pose.is_rest(), glb, output)?;
+        write_output(&avatar, &posed, args.pose.is_rest(), glb.then_some(motion.as_ref()), output)?;
         tracing::info!("wrote {} ({} vertices)", output.display(), avatar.canonical.num_vertices());
     }
     if let Some(path) = &args.gaussians {
         let scene = export::gaussian_scene(&avatar, &posed.gaussians)?;
         scene.write_ply(path)?;
         tracing::info!("wrote {} ({} Gaussians, SH degree {})", path.display(), scene.len(), scene.sh_degree);
+    }
+    if let Some(path) = &args.skinned_gaussians {
+        let bytes = export::skinned_gaussians_ply(&avatar, &canonical_pose(&avatar)?)?;
+        mannequin_io::write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+        tracing::info!("wrote {} ({} Gaussians with their skinning)", path.display(), avatar.num_gaussians());
     }
     Ok(())
 }

@@ -112,6 +112,43 @@ fn export_writes_meshes_glb_and_splats() {
         assert!(report.contains(" 0 errors"), "validator:\n{report}");
     }
 
+    // Animated: the skinned glTF with the walk as its animation, and the canonical Gaussians with
+    // their skinning as extra float properties after the INRIA ones (docs/viewer.md).
+    let (animated, skinned) = (out.join("walk.glb"), out.join("skinned.ply"));
+    ok(mannequin(&[
+        "export",
+        "--avatar",
+        s(model()),
+        "-o",
+        s(&animated),
+        "--animation",
+        s(&walk()),
+        "--skinned-gaussians",
+        s(&skinned),
+    ]));
+    if let Some(report) = KHRONOS_VALIDATOR.run(&animated) {
+        assert!(report.contains(" 0 errors"), "validator:\n{report}");
+    }
+    assert!(String::from_utf8_lossy(&std::fs::read(&animated).unwrap()[..4096]).contains("\"animations\""));
+    let scene = SplatScene::read_ply(&skinned).unwrap();
+    close(&scene.means, &host(canonical.gaussians.means.clone()), 1e-5, "canonical Gaussian means");
+    let bytes = std::fs::read(&skinned).unwrap();
+    let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    let names: Vec<&str> = header.lines().filter_map(|l| l.strip_prefix("property float ")).collect();
+    let column = |n: &str| names.iter().position(|&m| m == n).unwrap_or_else(|| panic!("no property {n}"));
+    let value = |g: usize, n: &str| {
+        let at = end + 4 * (g * names.len() + column(n));
+        f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap())
+    };
+    for g in (0..scene.len()).step_by(97) {
+        let sum: f32 = (0..4).map(|k| value(g, &format!("weight_{k}"))).sum();
+        assert!((sum - 1.0).abs() < 1e-5, "Gaussian {g}: weights sum to {sum}");
+        assert!(
+            (0..4).all(|k| value(g, &format!("joint_{k}")) < 24.0 && value(g, &format!("weight_{k}")) >= 0.0)
+        );
+    }
+
     // 3DGS splats at a motion frame: the avatar's posed Gaussians.
     let splats = out.join("splats.ply");
     ok(mannequin(&[

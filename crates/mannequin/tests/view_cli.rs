@@ -328,8 +328,9 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
     for frame in [10usize, 40] {
         let (pose, transl) = walk.frame_pose(frame, avatar.canonical.num_joints()).unwrap();
         let posed = avatar.pose(&pose, transl).unwrap();
-        let alpha: Vec<f32> =
-            avatar.render(&posed, &camera).unwrap().alpha.into_data().iter::<f32>().collect();
+        let rendered = avatar.render(&posed, &camera).unwrap();
+        let alpha: Vec<f32> = rendered.alpha.clone().into_data().iter::<f32>().collect();
+        let rgb: Vec<f32> = rendered.rgb().into_data().iter::<f32>().collect();
         let truth: Vec<bool> = alpha.iter().map(|&a| a > 0.5).collect();
         let (shot, coverage) = coverage_at(&mut browser, frame as f64 / 30.0, size);
         shot.write_png(&dir.join(format!("page_{frame:04}.png"))).unwrap();
@@ -339,6 +340,17 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
         let score = iou(&page, &truth);
         eprintln!("avatar frame {frame}: silhouette IoU {score:.3}");
         assert!(score >= 0.9, "frame {frame}: silhouette IoU {score:.3} against the avatar's own render");
+        // Colour over white (the render is channel-major): the page draws the same Gaussians.
+        let n = size * size;
+        let person: Vec<usize> = (0..n).filter(|&i| page[i] || truth[i]).collect();
+        let squared: f64 = person
+            .iter()
+            .flat_map(|&i| (0..3).map(move |c| (i, c)))
+            .map(|(i, c)| f64::from(shot.pixels[i][c] - rgb[c * n + i]).powi(2))
+            .sum();
+        let psnr = -10.0 * (squared / (3 * person.len()) as f64).log10();
+        eprintln!("avatar frame {frame}: PSNR {psnr:.1} dB over the person");
+        assert!(psnr >= 28.0, "frame {frame}: PSNR {psnr:.1} dB against the avatar's own render");
         drawn.push(page);
     }
     let moved = drawn[0].iter().zip(&drawn[1]).filter(|(a, b)| a != b).count();

@@ -9,7 +9,7 @@ npx esbuild src/main.js --bundle --format=esm --minify --target=es2022 \
   --legal-comments=none --outfile=dist/viewer.js
 {
   echo "dist/viewer.js bundles src/ (Mannequin) with these packages, unmodified:"
-  for package in three @sparkjsdev/spark fflate; do
+  for package in three; do
     dir="node_modules/$package"
     version="$(node -p "require('./$dir/package.json').version")"
     echo

@@ -7,16 +7,20 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
-use mannequin_avatar::{Avatar, export};
-use mannequin_body::{Motion, skeletal_animation};
+use mannequin_avatar::{AVATAR_DILATION, Avatar, export};
+use mannequin_body::Motion;
 use mannequin_mesh::gltf::scene_glb_bytes;
 use mannequin_splat::SplatScene;
 use serde_json::{Value, json};
 
 use super::http::{Response, content_type, resolve};
+use crate::export::{avatar_animation, canonical_pose};
 
 const INDEX: &[u8] = include_bytes!("../../viewer/src/index.html");
 const VIEWER: &[u8] = include_bytes!("../../viewer/dist/viewer.js");
+
+/// 3DGS's screen-space dilation, for splat files from other tools.
+const DILATION_3DGS: f64 = 0.3;
 
 /// The procedural walk an avatar plays when no motion is given: seconds and frames per second.
 const WALK: (f32, f32) = (4.0, 30.0);
@@ -29,6 +33,9 @@ struct Layer {
     kind: &'static str,
     skeleton: Option<String>,
     visible: bool,
+    /// Splats' screen-space dilation (pixels² added to each footprint's covariance): an avatar's
+    /// own (its renders use it), else 3DGS's 0.3.
+    dilation: Option<f64>,
 }
 
 pub struct Site {
@@ -83,7 +90,10 @@ impl Site {
             full.file_name().map_or_else(|| full.display().to_string(), |n| n.to_string_lossy().into_owned());
         let layers: Vec<Value> = layers
             .iter()
-            .map(|l| json!({ "name": l.name, "url": l.url, "kind": l.kind, "skeleton": l.skeleton, "visible": l.visible }))
+            .map(|l| json!({
+                    "name": l.name, "url": l.url, "kind": l.kind, "skeleton": l.skeleton, "visible": l.visible,
+                    "dilation": l.dilation,
+                }))
             .collect();
         let mut manifest = json!({ "title": title, "layers": layers });
         if let (Some(m), Value::Object(e)) = (manifest.as_object_mut(), extra) {
@@ -97,16 +107,14 @@ impl Site {
     /// skeleton; returns the motion's name.
     fn add_avatar(&mut self, dir: &Path, motion: Option<&Path>, layers: &mut Vec<Layer>) -> Result<String> {
         let avatar = Avatar::load(dir, &Device::flex())?;
-        let j = avatar.canonical.num_joints();
-        let canonical = avatar.pose(&vec![0.0; 3 * j], [0.0; 3])?;
+        let canonical = canonical_pose(&avatar)?;
         let (motion, name) = match motion {
             Some(p) => (Motion::read(p)?, p.display().to_string()),
             None => {
                 (Motion::walk_cycle(WALK.0, WALK.1), "a procedural walk (--motion to choose)".to_string())
             }
         };
-        let poses = motion.poses_for_joints(j)?;
-        let animation = skeletal_animation(j, &poses, &motion.trans, motion.fps)?;
+        let animation = avatar_animation(&avatar, &motion)?;
         let skinned = export::skinned_mesh(&avatar, &canonical)?;
         let glb = scene_glb_bytes(&dir.join("avatar.glb"), &skinned, Some(&animation), &[])?;
         self.generated.insert("avatar.glb".into(), ("model/gltf-binary", glb));
@@ -119,6 +127,7 @@ impl Site {
             skeleton: None,
             // The Gaussians are the avatar; its mesh carries their skeleton and is a toggle.
             visible: false,
+            dilation: None,
         });
         layers.push(Layer {
             name: "avatar".into(),
@@ -126,6 +135,7 @@ impl Site {
             kind: "splats",
             skeleton: Some("avatar mesh".into()),
             visible: true,
+            dilation: Some(AVATAR_DILATION),
         });
         Ok(name)
     }
@@ -158,7 +168,14 @@ impl Site {
         let name = |p: &Path| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let first_glb = layers.len();
         for p in files.iter().filter(|p| extension(p).as_deref() == Some("glb")) {
-            layers.push(Layer { name: name(p), url: url(p)?, kind: "glb", skeleton: None, visible: true });
+            layers.push(Layer {
+                name: name(p),
+                url: url(p)?,
+                kind: "glb",
+                skeleton: None,
+                visible: true,
+                dilation: None,
+            });
         }
         let skeleton = layers.get(first_glb).filter(|l| l.kind == "glb").map(|l| l.name.clone());
         for p in files.iter().filter(|p| extension(p).as_deref() == Some("ply")) {
@@ -169,8 +186,17 @@ impl Site {
             }
             let header_end = bytes.len().min(64 * 1024);
             let skinned = String::from_utf8_lossy(&bytes[..header_end]).contains("property float joint_0\n");
-            let skeleton = if skinned { skeleton.clone() } else { None };
-            layers.push(Layer { name: name(p), url: url(p)?, kind: "splats", skeleton, visible: true });
+            // Skinned splats are an avatar's (`export --skinned-gaussians`), drawn as it draws them.
+            let (skeleton, dilation) =
+                if skinned { (skeleton.clone(), AVATAR_DILATION) } else { (None, DILATION_3DGS) };
+            layers.push(Layer {
+                name: name(p),
+                url: url(p)?,
+                kind: "splats",
+                skeleton,
+                visible: true,
+                dilation: Some(dilation),
+            });
         }
         Ok(())
     }

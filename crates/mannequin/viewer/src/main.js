@@ -8,9 +8,9 @@
 import * as THREE from "three";
 import { OrbitControls } from "three/addons/controls/OrbitControls.js";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
-import { SparkRenderer, SplatMesh, SplatSkinning } from "@sparkjsdev/spark";
-import { readSkinning } from "./splat_skinning.js";
+import { GaussianSplats } from "./gaussian_splats.js";
 import { cameraFromOpenCv } from "./opencv_camera.js";
+import { readPly } from "./ply.js";
 
 const params = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
@@ -22,16 +22,17 @@ function fail(message) {
   console.error(message);
 }
 
+const manifest = await (await fetch("/scene.json")).json();
 const canvas = $("view");
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+// Multisampling costs splats half their frame rate on software WebGL and does not improve them.
+const antialias = !manifest.layers.some((l) => l.kind === "splats");
+const renderer = new THREE.WebGLRenderer({ canvas, antialias, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
 const scene = new THREE.Scene();
 scene.add(new THREE.HemisphereLight(0xffffff, 0x505060, 2.0));
 const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(-1, 2, 3);
 scene.add(sun);
-const spark = new SparkRenderer({ renderer });
-scene.add(spark);
 
 const background = params.get("bg") ?? "#20242a";
 scene.background = new THREE.Color(background);
@@ -63,6 +64,7 @@ if (fixed) {
 // The timeline: one clock for every layer's animation.
 const mixers = [];
 const skinnedSplats = [];
+const splatLayers = [];
 let playing = !params.has("t");
 let time = Number(params.get("t") ?? 0);
 let speed = 1;
@@ -135,48 +137,31 @@ async function loadGltf(layer) {
   return { root, skeleton: skinned[0]?.skeleton ?? null };
 }
 
-// Splats skinned to a glTF skeleton: each splat moves by S_k = bone_k.matrixWorld · boneInverse_k
-// (the matrix three.js skins the mesh's vertices with), blended over its four weights as dual
-// quaternions (Spark's linear blending needs its covariance splats, which fail to load .ply).
-// S_k is rigid: Mannequin's bind pose has identity rotations and no scale.
+// Splats (a 3DGS .ply), skinned to a glTF layer's skeleton when the file carries skinning: each
+// splat then moves by its weights' blend of S_k = bone_k.matrixWorld · boneInverse_k, the matrix
+// three.js skins that layer's vertices with.
 async function loadSplats(layer, skeletons) {
   const bytes = new Uint8Array(await (await fetch(layer.url)).arrayBuffer());
-  const splats = new SplatMesh({ fileBytes: bytes.slice(), fileType: "ply" });
-  await splats.initialized;
+  const { count, columns } = readPly(bytes, layer.url);
+  const splats = new GaussianSplats(count, columns, { dilation: layer.dilation ?? 0.3 });
   scene.add(splats);
   addToggle(layer.name, splats);
+  splatLayers.push(splats);
   if (!layer.skeleton) return;
   const skeleton = skeletons.get(layer.skeleton);
   if (!skeleton) throw new Error(`${layer.url}: no skinned mesh in layer '${layer.skeleton}' to follow`);
-  const skin = readSkinning(bytes, layer.url);
-  const bones = skeleton.bones.length;
-  const skinning = new SplatSkinning({ mesh: splats, numSplats: skin.count, numBones: bones });
-  const [q, p, scale] = [new THREE.Quaternion(), new THREE.Vector3(), new THREE.Vector3()];
-  for (let k = 0; k < bones; k++) skinning.setRestQuatPos(k, q, p);
-  const j = new THREE.Vector4();
-  const w = new THREE.Vector4();
-  for (let i = 0; i < skin.count; i++) {
-    j.fromArray(skin.joints, 4 * i);
-    w.fromArray(skin.weights, 4 * i);
-    skinning.setSplatBones(i, j, w);
-  }
-  splats.skinning = skinning;
-  splats.updateGenerator();
-  const m = new THREE.Matrix4();
+  if (!splats.skin) throw new Error(`${layer.url}: no joint_0..3 / weight_0..3 properties to skin by`);
+  const matrices = skeleton.bones.map(() => new THREE.Matrix4());
+  splats.setBones(matrices);
   skinnedSplats.push({
     update() {
-      for (let k = 0; k < bones; k++) {
-        m.multiplyMatrices(skeleton.bones[k].matrixWorld, skeleton.boneInverses[k]);
-        m.decompose(p, q, scale);
-        skinning.setBoneQuatPos(k, q, p);
-      }
-      skinning.updateBones();
+      skeleton.bones.forEach((bone, k) => matrices[k].multiplyMatrices(bone.matrixWorld, skeleton.boneInverses[k]));
+      splats.bonesMoved();
     },
   });
 }
 
 async function load() {
-  const manifest = await (await fetch("/scene.json")).json();
   $("title").textContent = manifest.title;
   document.title = `${manifest.title} · Mannequin`;
   const skeletons = new Map();
@@ -194,7 +179,7 @@ async function load() {
 
 // Points the orbiting camera at everything loaded, from the front (+z), whole body in view.
 function frameScene() {
-  const box = new THREE.Box3().setFromObject(scene, true);
+  const box = new THREE.Box3().setFromObject(scene);
   if (box.isEmpty()) return;
   const centre = box.getCenter(new THREE.Vector3());
   const size = box.getSize(new THREE.Vector3()).length();
@@ -242,6 +227,11 @@ function frame(now) {
   last = now;
   if (playing && status.duration > 0) setTime(time + dt * speed);
   controls?.update();
+  const size = renderer.getDrawingBufferSize(new THREE.Vector2());
+  const start = performance.now();
+  for (const splats of splatLayers) if (splats.visible) splats.update(camera, size.x, size.y);
+  status.splatUpdateMs = performance.now() - start;
+  status.splatsDrawn = splatLayers.map((s) => (s.visible ? s.geometry.instanceCount : 0));
   renderer.render(scene, camera);
   status.frames += 1;
   fpsFrames += 1;
