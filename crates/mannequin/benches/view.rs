@@ -66,6 +66,7 @@ fn main() {
 
     let Some(mut browser) = Browser::launch(width, height) else {
         let _ = server.kill();
+        let _ = server.wait();
         return;
     };
     browser.navigate(&url);
@@ -85,6 +86,7 @@ fn main() {
     let mesh_rate = frame_rate(&mut browser, seconds);
     assert!(browser.errors.is_empty(), "console errors: {:?}", browser.errors);
     let _ = server.kill();
+    let _ = server.wait();
 
     let webgl = browser.eval(
         "(() => { const gl = document.createElement('canvas').getContext('webgl2'); \

@@ -317,10 +317,26 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
         "--body",
         "default-lod1",
     ]));
+    ok(mannequin(&[
+        "eval",
+        "--avatar",
+        s(&model),
+        "--data",
+        s(&data),
+        "--samples",
+        "500",
+        "--json",
+        s(&dir.join("eval.json")),
+    ]));
     let size = 256;
     let (camera, camera_json) = front_camera(size);
-    let viewer = Viewer::start(&[s(&model)]);
+    let viewer = Viewer::start(&[s(&model), "--data", s(&data)]);
     let Some(mut browser) = open(&viewer.url, &camera_json, size) else { return };
+    // The first novel view `eval` rendered, beside its ground truth from the dataset.
+    let compare = browser.eval(
+        "Promise.all([...document.querySelectorAll('#compare img')].map(i => i.decode().then(() => [i.alt, i.naturalWidth])))",
+    );
+    assert_eq!(compare, json!([["render", 96], ["ground truth", 96]]), "the side-by-side images");
 
     let avatar = Avatar::load(&model, &Device::flex()).unwrap();
     let walk = Motion::walk_cycle(4.0, 30.0);

@@ -62,6 +62,10 @@ if (fixed) {
 }
 
 // The timeline: one clock for every layer's animation.
+// The orbiting camera follows the first skeleton's root, so a walk stays in view.
+let followed = null;
+const followedAt = new THREE.Vector3();
+const followedNow = new THREE.Vector3();
 const mixers = [];
 const skinnedSplats = [];
 const splatLayers = [];
@@ -122,6 +126,7 @@ async function loadGltf(layer) {
   });
   const skinned = [];
   root.traverse((o) => o.isSkinnedMesh && skinned.push(o));
+  followed ??= skinned[0]?.skeleton.bones[0] ?? null;
   if (skinned.length > 0) {
     const helper = new THREE.SkeletonHelper(root);
     helper.visible = false;
@@ -171,8 +176,9 @@ async function load() {
   }
   for (const layer of manifest.layers.filter((l) => l.kind === "splats")) await loadSplats(layer, skeletons);
   if (manifest.compare) showCompare(manifest.compare);
-  if (controls) frameScene();
   setTime(time);
+  if (controls) frameScene();
+  followed?.getWorldPosition(followedAt);
   const parts = manifest.layers.map((l) => `${l.name} (${l.kind})`).join(", ");
   $("status").textContent = `${parts}\n${status.duration.toFixed(2)} s of motion`;
 }
@@ -198,7 +204,7 @@ function showCompare(compare) {
     img.title = label;
     box.append(img);
   }
-  box.style.display = "block";
+  box.classList.add("shown");
 }
 
 // Files dropped on the page: a .glb (its animation joins the timeline) or a 3DGS .ply.
@@ -226,6 +232,13 @@ function frame(now) {
   const dt = Math.min((now - last) / 1000, 0.1);
   last = now;
   if (playing && status.duration > 0) setTime(time + dt * speed);
+  if (controls && followed) {
+    followed.getWorldPosition(followedNow);
+    const step = followedNow.clone().sub(followedAt);
+    camera.position.add(step);
+    controls.target.add(step);
+    followedAt.copy(followedNow);
+  }
   controls?.update();
   const size = renderer.getDrawingBufferSize(new THREE.Vector2());
   const start = performance.now();
