@@ -11,7 +11,7 @@ use mannequin_body::named_pose;
 use mannequin_splat::SplatScene;
 
 mod common;
-use common::{mannequin, ok, one_line_error, s, scratch, usage_error};
+use common::{mannequin, ok, one_line_error, s, scratch, tiny_avatar, usage_error};
 
 #[path = "../../../tools/node_checks.rs"]
 mod node_checks;
@@ -22,35 +22,7 @@ fn model() -> &'static Path {
     static MODEL: OnceLock<PathBuf> = OnceLock::new();
     MODEL.get_or_init(|| {
         let dir = scratch("avatar-cli-model");
-        let (data, model) = (dir.join("data"), dir.join("model"));
-        ok(mannequin(&[
-            "synth",
-            "--seed",
-            "1",
-            "--size",
-            "96",
-            "--frames",
-            "10",
-            "--train",
-            "8",
-            "--body",
-            "default-lod1",
-            "--out",
-            s(&data),
-        ]));
-        ok(mannequin(&[
-            "train",
-            "--data",
-            s(&data),
-            "--out",
-            s(&model),
-            "--iters",
-            "3",
-            "--checkpoint-every",
-            "3",
-            "--body",
-            "default-lod1",
-        ]));
+        let (_, model) = tiny_avatar(&dir);
         ok(mannequin(&["motion", "walk", "--seconds", "1", "-o", s(&dir.join("walk.npz"))]));
         model
     })

@@ -48,3 +48,38 @@ pub fn usage_error(o: &Output, needles: &[&str]) {
         assert!(err.contains(n), "'{n}' not in: {err}");
     }
 }
+
+/// A tiny synthetic subject (`dir/data`: 96², 10 frames, the light body) and an avatar trained on
+/// it for three iterations (`dir/model`): a few seconds.
+pub fn tiny_avatar(dir: &Path) -> (PathBuf, PathBuf) {
+    let (data, model) = (dir.join("data"), dir.join("model"));
+    ok(mannequin(&[
+        "synth",
+        "--seed",
+        "1",
+        "--size",
+        "96",
+        "--frames",
+        "10",
+        "--train",
+        "8",
+        "--body",
+        "default-lod1",
+        "--out",
+        s(&data),
+    ]));
+    ok(mannequin(&[
+        "train",
+        "--data",
+        s(&data),
+        "--out",
+        s(&model),
+        "--iters",
+        "3",
+        "--checkpoint-every",
+        "3",
+        "--body",
+        "default-lod1",
+    ]));
+    (data, model)
+}
