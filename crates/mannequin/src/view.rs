@@ -22,9 +22,10 @@ pub struct Args {
     /// Open the page in the system's browser.
     #[arg(long)]
     open: bool,
-    /// The motion an avatar plays (AMASS or PeopleSnapshot `.npz`); default: a procedural walk.
-    #[arg(long)]
-    motion: Option<PathBuf>,
+    /// Motions an avatar can play (AMASS or PeopleSnapshot `.npz`; repeat or separate with
+    /// commas), offered before those in its folder; with none at all, a procedural walk.
+    #[arg(long, value_delimiter = ',')]
+    motion: Vec<PathBuf>,
     /// The avatar's dataset, to show a test view beside its ground truth (after `mannequin eval`).
     #[arg(long)]
     data: Option<PathBuf>,
@@ -32,7 +33,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let compare = args.data.as_deref().map(|data| Compare { data });
-    let site = Site::load(&args.path, args.motion.as_deref(), compare)?;
+    let site = Site::load(&args.path, &args.motion, compare)?;
     let listener = TcpListener::bind(("127.0.0.1", args.port)).with_context(|| {
         format!("listening on 127.0.0.1:{} (pass another --port, or 0 for any)", args.port)
     })?;

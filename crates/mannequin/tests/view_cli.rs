@@ -310,7 +310,12 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
     ]));
     let size = 256;
     let (camera, camera_json) = front_camera(size);
-    let viewer = Viewer::start(&[s(&model), "--data", s(&data)]);
+    // Two motions to offer: the first is the procedural walk the page plays by default.
+    let (walk4, walk2) = (dir.join("walk4.npz"), dir.join("walk2.npz"));
+    ok(mannequin(&["motion", "walk", "--seconds", "4", "--fps", "30", "-o", s(&walk4)]));
+    ok(mannequin(&["motion", "walk", "--seconds", "2", "--fps", "30", "-o", s(&walk2)]));
+    let motions = format!("{},{}", s(&walk4), s(&walk2));
+    let viewer = Viewer::start(&[s(&model), "--data", s(&data), "--motion", &motions]);
     let Some(mut browser) = open(&viewer.url, &camera_json, size) else { return };
     // The first novel view `eval` rendered, beside its ground truth from the dataset.
     let compare = browser.eval(
@@ -346,4 +351,16 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
         drawn.push(page);
     }
     played_cleanly(&drawn, &browser);
+
+    // The second motion replaces the first on the timeline, and the avatar still shows.
+    assert_eq!(browser.eval("window.mannequin.motions()"), json!(["walk4", "walk2"]));
+    browser.eval("window.mannequin.chooseMotion(1).then(() => true)");
+    let short = Motion::read(&walk2).unwrap();
+    let duration = browser.eval("window.mannequin.duration").as_f64().unwrap();
+    let expected = (short.num_frames() - 1) as f64 / f64::from(short.fps);
+    assert!((duration - expected).abs() < 1e-3, "duration {duration} s after choosing walk2 ({expected} s)");
+    let (_, coverage) = coverage_at(&mut browser, 0.5, size);
+    let shown = coverage.iter().filter(|&&c| c > 0.5).count();
+    assert!(shown * 20 > size * size, "after choosing walk2 the avatar covers {shown} pixels");
+    assert!(browser.errors.is_empty(), "console errors: {:?}", browser.errors);
 }

@@ -51,10 +51,11 @@ pub struct Compare<'a> {
 }
 
 impl Site {
-    /// The site for `path`: an avatar folder (with `motion`, else a procedural walk; and its
+    /// The site for `path`: an avatar folder (with `motions` and those in the folder, else a
+    /// procedural walk; and its
     /// dataset `data` for a test view beside its ground truth), a folder of `.glb` and 3DGS `.ply`
     /// files (`dress` and `cloth simulate` outputs, exports), or one such file.
-    pub fn load(path: &Path, motion: Option<&Path>, compare: Option<Compare>) -> Result<Self> {
+    pub fn load(path: &Path, motions: &[PathBuf], compare: Option<Compare>) -> Result<Self> {
         let full =
             path.canonicalize().with_context(|| format!("{}: no such file or folder", path.display()))?;
         let (root, files) = if full.is_dir() {
@@ -68,12 +69,11 @@ impl Site {
         let is_avatar = full.is_dir() && full.join("avatar.json").is_file();
         let mut extra: Value = json!({});
         if is_avatar {
-            let motion_name = site.add_avatar(&full, motion, &mut layers)?;
-            extra["motion"] = json!(motion_name);
+            extra["motions"] = site.add_avatar(&full, motions, &mut layers)?;
             if let Some(c) = compare {
                 extra["compare"] = site.add_compare(&full, c.data)?;
             }
-        } else if motion.is_some() || compare.is_some() {
+        } else if !motions.is_empty() || compare.is_some() {
             bail!(
                 "{}: --motion and --data apply to an avatar folder (one holding avatar.json)",
                 path.display()
@@ -103,26 +103,43 @@ impl Site {
         Ok(site)
     }
 
-    /// The avatar's skinned mesh playing the motion, and its Gaussians skinned to the same
-    /// skeleton; returns the motion's name.
-    fn add_avatar(&mut self, dir: &Path, motion: Option<&Path>, layers: &mut Vec<Layer>) -> Result<String> {
+    /// The avatar's skinned mesh and its Gaussians skinned to the same skeleton, and a glTF of
+    /// the mesh per motion the page offers: `motions` (the `--motion` files), then the motion
+    /// files in the folder, or a procedural walk when there are none. Returns the motions' names
+    /// and URLs; the first is the mesh layer's own.
+    fn add_avatar(&mut self, dir: &Path, motions: &[PathBuf], layers: &mut Vec<Layer>) -> Result<Value> {
         let avatar = Avatar::load(dir, &Device::flex())?;
         let canonical = canonical_pose(&avatar)?;
-        let (motion, name) = match motion {
-            Some(p) => (Motion::read(p)?, p.display().to_string()),
-            None => {
-                (Motion::walk_cycle(WALK.0, WALK.1), "a procedural walk (--motion to choose)".to_string())
+        let mut named: Vec<(String, Motion)> = Vec::new();
+        for p in motions {
+            named.push((stem(p), Motion::read(p)?));
+        }
+        for p in sorted_files(dir)?.iter().filter(|p| p.extension().is_some_and(|e| e == "npz")) {
+            // The avatar's own files are not motions.
+            if ["avatar.npz", "checkpoint.npz"].iter().any(|n| p.ends_with(n)) {
+                continue;
             }
-        };
-        let animation = avatar_animation(&avatar, &motion)?;
+            match Motion::read(p) {
+                Ok(m) => named.push((stem(p), m)),
+                Err(e) => tracing::warn!("{}: not offered as a motion ({e})", p.display()),
+            }
+        }
+        if named.is_empty() {
+            named.push(("procedural walk".into(), Motion::walk_cycle(WALK.0, WALK.1)));
+        }
         let skinned = export::skinned_mesh(&avatar, &canonical)?;
-        let glb = scene_glb_bytes(&dir.join("avatar.glb"), &skinned, Some(&animation), &[])?;
-        self.generated.insert("avatar.glb".into(), ("model/gltf-binary", glb));
+        let mut offered = Vec::new();
+        for (k, (name, motion)) in named.iter().enumerate() {
+            let animation = avatar_animation(&avatar, motion)?;
+            let glb = scene_glb_bytes(&dir.join(format!("{name}.glb")), &skinned, Some(&animation), &[])?;
+            self.generated.insert(format!("motion_{k}.glb"), ("model/gltf-binary", glb));
+            offered.push(json!({ "name": name, "url": format!("/generated/motion_{k}.glb") }));
+        }
         let splats = export::skinned_gaussians_ply(&avatar, &canonical)?;
         self.generated.insert("gaussians.ply".into(), ("application/octet-stream", splats));
         layers.push(Layer {
             name: "avatar mesh".into(),
-            url: "/generated/avatar.glb".into(),
+            url: "/generated/motion_0.glb".into(),
             kind: "glb",
             skeleton: None,
             // The Gaussians are the avatar; its mesh carries their skeleton and is a toggle.
@@ -137,7 +154,7 @@ impl Site {
             visible: true,
             dilation: Some(AVATAR_DILATION),
         });
-        Ok(name)
+        Ok(json!({ "layer": "avatar mesh", "choices": offered }))
     }
 
     /// The first novel-view image `eval` rendered and the dataset's ground truth of that view.
@@ -165,11 +182,10 @@ impl Site {
             let name = p.file_name().context("a file has a name")?.to_string_lossy();
             Ok(format!("/files/{}", name.replace('%', "%25").replace(' ', "%20").replace('#', "%23")))
         };
-        let name = |p: &Path| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let first_glb = layers.len();
         for p in files.iter().filter(|p| extension(p).as_deref() == Some("glb")) {
             layers.push(Layer {
-                name: name(p),
+                name: stem(p),
                 url: url(p)?,
                 kind: "glb",
                 skeleton: None,
@@ -190,7 +206,7 @@ impl Site {
             let (skeleton, dilation) =
                 if skinned { (skeleton.clone(), AVATAR_DILATION) } else { (None, DILATION_3DGS) };
             layers.push(Layer {
-                name: name(p),
+                name: stem(p),
                 url: url(p)?,
                 kind: "splats",
                 skeleton,
@@ -228,6 +244,11 @@ impl Site {
             }
         }
     }
+}
+
+/// A file's name without its extension.
+fn stem(path: &Path) -> String {
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 /// The regular files directly in `dir`, by name.

@@ -12,7 +12,7 @@ const SH_C1 = 0.4886025119029199;
 const SH_C2 = [1.0925484305920792, -1.0925484305920792, 0.31539156525252005, -1.0925484305920792, 0.5462742152960396];
 /// The quad reaches this many standard deviations; 3DGS cuts its footprint at 3σ too.
 const EXTENT = 3;
-/// Floats per drawn splat: NDC centre, footprint axes, colour and opacity.
+/// Floats per corner of a drawn splat: NDC centre, footprint axes, colour and opacity.
 const STRIDE = 11;
 
 const VERTEX = /* glsl */ `
@@ -42,17 +42,21 @@ const FRAGMENT = /* glsl */ `
 /// SH colour (degree ≤ 2 used), and skinning where joint_0..3 / weight_0..3 are present.
 export class GaussianSplats extends THREE.Mesh {
   constructor(count, columns, { dilation = 0.3 } = {}) {
-    const geometry = new THREE.InstancedBufferGeometry();
+    // A plain triangle list, each splat's record repeated at its three corners: SwiftShader
+    // draws the same splats as instances thirty times slower.
+    const geometry = new THREE.BufferGeometry();
     // One triangle around the unit circle (the footprint at EXTENT σ) rather than a quad: a
     // software rasteriser's cost is per triangle more than per pixel, and this halves them.
     const h = Math.sqrt(3);
-    geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array([0, 2, 0, -h, -1, 0, h, -1, 0]), 3));
-    // One interleaved record per drawn splat: centre (3), axes (4), colour (4).
-    const records = new THREE.InstancedInterleavedBuffer(new Float32Array(count * STRIDE), STRIDE).setUsage(THREE.DynamicDrawUsage);
+    const corners = new Float32Array(9 * count);
+    for (let i = 0; i < count; i++) corners.set([0, 2, 0, -h, -1, 0, h, -1, 0], 9 * i);
+    geometry.setAttribute("position", new THREE.BufferAttribute(corners, 3));
+    // One interleaved record per corner of each drawn splat: centre (3), axes (4), colour (4).
+    const records = new THREE.InterleavedBuffer(new Float32Array(3 * count * STRIDE), STRIDE).setUsage(THREE.DynamicDrawUsage);
     geometry.setAttribute("center", new THREE.InterleavedBufferAttribute(records, 3, 0));
     geometry.setAttribute("axes", new THREE.InterleavedBufferAttribute(records, 4, 3));
     geometry.setAttribute("colour", new THREE.InterleavedBufferAttribute(records, 4, 7));
-    geometry.instanceCount = 0;
+    geometry.setDrawRange(0, 0);
     const material = new THREE.ShaderMaterial({
       vertexShader: VERTEX,
       fragmentShader: FRAGMENT,
@@ -86,6 +90,7 @@ export class GaussianSplats extends THREE.Mesh {
     this.visibleIndex = new Uint32Array(count);
     this.order = new Uint32Array(count);
     this.unsorted = { centre: new Float32Array(3 * count), axes: new Float32Array(4 * count), colour: new Float32Array(4 * count) };
+    this.drawn = 0;
     this.blend = new Float64Array(12);
     this.camCov = new Float64Array(6);
     this.basis = new Float64Array(9);
@@ -234,14 +239,17 @@ export class GaussianSplats extends THREE.Mesh {
     const out = records.array;
     for (let k = 0; k < visible; k++) {
       const i = order[k];
-      const at = STRIDE * k;
-      for (let q = 0; q < 3; q++) out[at + q] = unsorted.centre[3 * i + q];
-      for (let q = 0; q < 4; q++) out[at + 3 + q] = unsorted.axes[4 * i + q];
-      for (let q = 0; q < 4; q++) out[at + 7 + q] = unsorted.colour[4 * i + q];
+      for (let corner = 0; corner < 3; corner++) {
+        const at = STRIDE * (3 * k + corner);
+        for (let q = 0; q < 3; q++) out[at + q] = unsorted.centre[3 * i + q];
+        for (let q = 0; q < 4; q++) out[at + 3 + q] = unsorted.axes[4 * i + q];
+        for (let q = 0; q < 4; q++) out[at + 7 + q] = unsorted.colour[4 * i + q];
+      }
     }
-    records.addUpdateRange(0, STRIDE * visible);
+    records.addUpdateRange(0, 3 * STRIDE * visible);
     records.needsUpdate = true;
-    this.geometry.instanceCount = visible;
+    this.geometry.setDrawRange(0, 3 * visible);
+    this.drawn = visible;
     this.material.uniforms.viewport.value.set(width, height);
   }
 }

@@ -3,8 +3,8 @@
 // skeleton) on one timeline. Query parameters, for reproducible screenshots:
 //   camera=<camera JSON, as `splat render --camera` reads it>  fixes the view and canvas size
 //   t=<seconds>  starts paused at that time;  bg=<CSS colour>;  ui=0 hides the panel.
-// window.mannequin exposes ready, frames (drawn so far), fps, duration, setTime(t) and
-// setBackground(colour) to tests and benchmarks.
+// window.mannequin exposes ready, frames (drawn so far), fps, duration, setTime(t),
+// setBackground(colour), motions() and chooseMotion(i) to tests and benchmarks.
 import * as THREE from "three";
 import { OrbitControls } from "three/addons/controls/OrbitControls.js";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
@@ -67,6 +67,7 @@ let followed = null;
 const followedAt = new THREE.Vector3();
 const followedNow = new THREE.Vector3();
 const mixers = [];
+const layerMixers = new Map();
 const skinnedSplats = [];
 const splatLayers = [];
 let playing = !params.has("t");
@@ -137,6 +138,7 @@ async function loadGltf(layer) {
     const mixer = new THREE.AnimationMixer(root);
     for (const clip of gltf.animations) mixer.clipAction(clip).play();
     mixers.push(mixer);
+    layerMixers.set(layer.name, mixer);
     status.duration = Math.max(status.duration, ...gltf.animations.map((c) => c.duration));
   }
   return { root, skeleton: skinned[0]?.skeleton ?? null };
@@ -176,6 +178,7 @@ async function load() {
   }
   for (const layer of manifest.layers.filter((l) => l.kind === "splats")) await loadSplats(layer, skeletons);
   if (manifest.compare) showCompare(manifest.compare);
+  if (manifest.motions) offerMotions(manifest.motions);
   setTime(time);
   if (controls) frameScene();
   followed?.getWorldPosition(followedAt);
@@ -193,6 +196,27 @@ function frameScene() {
   camera.position.set(centre.x, centre.y, centre.z + 1.6 * size);
   controls.update();
 }
+
+// The motions an avatar can play: each a glTF of its mesh with one animation, whose clip
+// replaces the one its layer plays.
+function offerMotions({ layer, choices }) {
+  const select = $("motion");
+  for (const { name, url } of choices) select.append(new Option(name, url));
+  select.hidden = false;
+  select.onchange = async () => {
+    const mixer = layerMixers.get(layer);
+    const [clip] = (await new GLTFLoader().loadAsync(select.value)).animations;
+    mixer.stopAllAction();
+    mixer.clipAction(clip).play();
+    status.duration = clip.duration;
+    setTime(0);
+  };
+}
+status.motions = () => [...$("motion").options].map((o) => o.text);
+status.chooseMotion = (index) => {
+  $("motion").selectedIndex = index;
+  return $("motion").onchange();
+};
 
 // A test view beside its ground truth, for an avatar folder with its dataset.
 function showCompare(compare) {
@@ -244,7 +268,7 @@ function frame(now) {
   const start = performance.now();
   for (const splats of splatLayers) if (splats.visible) splats.update(camera, size.x, size.y);
   status.splatUpdateMs = performance.now() - start;
-  status.splatsDrawn = splatLayers.map((s) => (s.visible ? s.geometry.instanceCount : 0));
+  status.splatsDrawn = splatLayers.map((s) => (s.visible ? s.drawn : 0));
   renderer.render(scene, camera);
   status.frames += 1;
   fpsFrames += 1;
