@@ -289,6 +289,19 @@ fn a_dressed_walk_plays_in_the_browser() {
         drawn.push(page);
     }
     played_cleanly(&drawn, &browser);
+
+    // A .glb dropped on the page joins the scene as more layers.
+    let dropped = browser.eval(
+        "(async () => { const bytes = await (await fetch('/files/dressed.glb')).arrayBuffer(); \
+           const before = window.mannequin.layers.length; const data = new DataTransfer(); \
+           data.items.add(new File([bytes], 'again.glb')); \
+           document.dispatchEvent(new DragEvent('drop', { dataTransfer: data, cancelable: true })); \
+           for (let i = 0; i < 200 && window.mannequin.layers.length === before; i++) \
+             await new Promise(r => setTimeout(r, 50)); \
+           return window.mannequin.layers.length - before; })()",
+    );
+    assert!(dropped.as_u64().is_some_and(|n| n >= 3), "a dropped .glb added {dropped} layers");
+    assert!(browser.errors.is_empty(), "console errors: {:?}", browser.errors);
 }
 
 /// A trained avatar's Gaussians, skinned to its skeleton and played on the page, cover what the
