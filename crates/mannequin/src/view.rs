@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 
-use site::{Compare, Site};
+use site::Site;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -32,8 +32,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let compare = args.data.as_deref().map(|data| Compare { data });
-    let site = Site::load(&args.path, &args.motion, compare)?;
+    let site = Site::load(&args.path, &args.motion, args.data.as_deref())?;
     let listener = TcpListener::bind(("127.0.0.1", args.port)).with_context(|| {
         format!("listening on 127.0.0.1:{} (pass another --port, or 0 for any)", args.port)
     })?;

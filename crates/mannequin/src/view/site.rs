@@ -45,17 +45,12 @@ pub struct Site {
     generated: HashMap<String, (&'static str, Vec<u8>)>,
 }
 
-/// The viewed avatar's test view and its ground truth, when the dataset is given.
-pub struct Compare<'a> {
-    pub data: &'a Path,
-}
-
 impl Site {
-    /// The site for `path`: an avatar folder (with `motions` and those in the folder, else a
-    /// procedural walk; and its
-    /// dataset `data` for a test view beside its ground truth), a folder of `.glb` and 3DGS `.ply`
-    /// files (`dress` and `cloth simulate` outputs, exports), or one such file.
-    pub fn load(path: &Path, motions: &[PathBuf], compare: Option<Compare>) -> Result<Self> {
+    /// The site for `path`: an avatar folder (playing `motions` and those in the folder, else a
+    /// procedural walk; with its dataset `data`, a test view beside its ground truth), a folder
+    /// of `.glb` and 3DGS `.ply` files (`dress` and `cloth simulate` outputs, exports), or one
+    /// such file.
+    pub fn load(path: &Path, motions: &[PathBuf], data: Option<&Path>) -> Result<Self> {
         let full =
             path.canonicalize().with_context(|| format!("{}: no such file or folder", path.display()))?;
         let (root, files) = if full.is_dir() {
@@ -70,10 +65,10 @@ impl Site {
         let mut extra: Value = json!({});
         if is_avatar {
             extra["motions"] = site.add_avatar(&full, motions, &mut layers)?;
-            if let Some(c) = compare {
-                extra["compare"] = site.add_compare(&full, c.data)?;
+            if let Some(data) = data {
+                extra["compare"] = site.add_compare(&full, data)?;
             }
-        } else if !motions.is_empty() || compare.is_some() {
+        } else if !motions.is_empty() || data.is_some() {
             bail!(
                 "{}: --motion and --data apply to an avatar folder (one holding avatar.json)",
                 path.display()
