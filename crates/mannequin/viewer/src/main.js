@@ -61,6 +61,44 @@ if (fixed) {
   resize();
 }
 
+// Cloth caches come as one morph target per frame; three.js's shaders loop over every target of
+// a mesh for every vertex, which a long clip makes slow, so past this many targets the page
+// blends the (at most two) weighted frames itself.
+const MAX_SHADER_MORPHS = 8;
+const morphCaches = [];
+
+/// Takes `mesh`'s morph targets out of its shaders: its positions become the base plus the
+/// weighted targets, recomputed when the timeline moves.
+function playOnCpu(mesh) {
+  const geometry = mesh.geometry;
+  const targets = geometry.morphAttributes.position.map((a) => a.array);
+  const relative = geometry.morphTargetsRelative;
+  const base = geometry.attributes.position.array.slice();
+  geometry.morphAttributes = {};
+  // The loader's bounds span every frame (the whole path walked); frame the base instead.
+  geometry.computeBoundingBox();
+  geometry.computeBoundingSphere();
+  const influences = mesh.morphTargetInfluences;
+  const position = geometry.attributes.position;
+  position.setUsage(THREE.DynamicDrawUsage);
+  return {
+    update() {
+      const out = position.array;
+      let total = 0;
+      out.set(base);
+      influences.forEach((w, k) => {
+        if (w === 0) return;
+        total += w;
+        const target = targets[k];
+        for (let i = 0; i < out.length; i++) out[i] += w * (relative ? target[i] : target[i] - base[i]);
+      });
+      position.needsUpdate = true;
+      geometry.computeVertexNormals();
+      return total;
+    },
+  };
+}
+
 // The timeline: one clock for every layer's animation.
 // The orbiting camera follows the first skeleton's root, so a walk stays in view.
 let followed = null;
@@ -91,6 +129,7 @@ function setTime(t) {
   time = status.duration > 0 ? ((t % status.duration) + status.duration) % status.duration : 0;
   status.time = time;
   for (const mixer of mixers) mixer.setTime(time);
+  for (const cache of morphCaches) cache.update();
   scene.updateMatrixWorld(true);
   for (const s of skinnedSplats) s.update();
   $("timeline").value = status.duration > 0 ? time / status.duration : 0;
@@ -123,6 +162,7 @@ async function loadGltf(layer) {
       o.frustumCulled = false;
       o.visible = layer.visible !== false;
       addToggle(o.name || layer.name, o);
+      if ((o.geometry.morphAttributes.position?.length ?? 0) > MAX_SHADER_MORPHS) morphCaches.push(playOnCpu(o));
     }
   });
   const skinned = [];
