@@ -81,7 +81,7 @@ fn main() {
     browser.eval(
         "for (const box of document.querySelectorAll('#layers input')) { \
            const name = box.parentElement.textContent.trim(); \
-           if ((name === 'avatar' && box.checked) || (name === 'mesh' && !box.checked)) box.click(); } true",
+           if ((name === 'avatar' && box.checked) || (name === 'body' && !box.checked)) box.click(); } true",
     );
     let mesh_rate = frame_rate(&mut browser, seconds);
     assert!(browser.errors.is_empty(), "console errors: {:?}", browser.errors);

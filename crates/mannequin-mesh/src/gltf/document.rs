@@ -104,8 +104,8 @@ fn encode(
             node
         })
         .collect();
-    nodes.push(json!({ "name": "mesh", "mesh": 0, "skin": 0 }));
-    let mut meshes = vec![json!({ "name": "mesh", "primitives": [primitive] })];
+    nodes.push(json!({ "name": "body", "mesh": 0, "skin": 0 }));
+    let mut meshes = vec![json!({ "name": "body", "primitives": [primitive] })];
     let mut roots = vec![0, joints];
     for (i, m) in morphs.iter().enumerate() {
         roots.push(nodes.len());

@@ -17,7 +17,8 @@ pub struct Skeleton {
     pub bind_joints: Vec<[f32; 3]>,
 }
 
-/// A bind-pose mesh with its skeleton and dense linear-blend-skinning weights.
+/// A bind-pose mesh with its skeleton and dense linear-blend-skinning weights: a body (the glTF
+/// node and mesh are named `body`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SkinnedMesh {
     /// Bind-pose vertices in metres; its UVs and colours are exported when present.
