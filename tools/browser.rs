@@ -234,3 +234,42 @@ fn base64_decode(text: &str) -> Vec<u8> {
     }
     out
 }
+
+/// A running `mannequin view … --port 0` (the binary of the test or bench including this file),
+/// stopped when dropped.
+pub struct ViewServer {
+    child: Child,
+    /// `http://127.0.0.1:PORT`, without the trailing slash.
+    pub url: String,
+    pub port: u16,
+}
+
+impl ViewServer {
+    pub fn start(args: &[&str]) -> Self {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_mannequin"))
+            .arg("view")
+            .args(args)
+            .args(["--port", "0"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("starting mannequin view");
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+        let url = line
+            .split_whitespace()
+            .find(|w| w.starts_with("http://"))
+            .unwrap_or_else(|| panic!("no URL in {line}"))
+            .trim_end_matches('/')
+            .to_string();
+        let port = url.rsplit(':').next().unwrap().parse().unwrap();
+        ViewServer { child, url, port }
+    }
+}
+
+impl Drop for ViewServer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}

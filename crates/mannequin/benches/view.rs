@@ -10,9 +10,7 @@
 //!
 //! `cargo bench -p mannequin --bench view -- [--avatar DIR] [--seconds 10] [--width 960] [--height 540]`
 
-use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use burn::tensor::Device;
@@ -25,7 +23,7 @@ use bench_args::arg;
 
 #[path = "../../../tools/browser.rs"]
 mod browser;
-use browser::Browser;
+use browser::{Browser, ViewServer};
 
 /// The page's frames per second over `seconds` of playing, after a second to settle.
 fn frame_rate(browser: &mut Browser, seconds: f64) -> f64 {
@@ -54,22 +52,9 @@ fn main() {
     };
     let splats = Avatar::load(&avatar_dir, &Device::flex()).expect("loading the avatar").num_gaussians();
 
-    let mut server = Command::new(env!("CARGO_BIN_EXE_mannequin"))
-        .args(["view", avatar_dir.to_str().unwrap(), "--port", "0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("starting mannequin view");
-    let mut line = String::new();
-    BufReader::new(server.stdout.take().unwrap()).read_line(&mut line).unwrap();
-    let url =
-        line.split_whitespace().find(|w| w.starts_with("http://")).expect("the viewer's URL").to_string();
-
-    let Some(mut browser) = Browser::launch(width, height) else {
-        let _ = server.kill();
-        let _ = server.wait();
-        return;
-    };
-    browser.navigate(&url);
+    let server = ViewServer::start(&[avatar_dir.to_str().unwrap()]);
+    let Some(mut browser) = Browser::launch(width, height) else { return };
+    browser.navigate(&server.url);
     browser.wait_for("window.mannequin?.ready === true", Duration::from_secs(180));
     let splat_rate = frame_rate(&mut browser, seconds);
     let update_ms = browser.eval("window.mannequin.splatUpdateMs").as_f64().unwrap_or(f64::NAN);
@@ -85,8 +70,6 @@ fn main() {
     );
     let mesh_rate = frame_rate(&mut browser, seconds);
     assert!(browser.errors.is_empty(), "console errors: {:?}", browser.errors);
-    let _ = server.kill();
-    let _ = server.wait();
 
     let webgl = browser.eval(
         "(() => { const gl = document.createElement('canvas').getContext('webgl2'); \

@@ -2,10 +2,10 @@
 //! and in headless Chromium the page draws a dressed walk and a trained avatar's Gaussians where
 //! the project's own renderers draw them, animated, with no console errors.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::{TcpStream, UdpSocket};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::time::Duration;
 
 use burn::tensor::Device;
@@ -20,57 +20,21 @@ use common::{mannequin, ok, one_line_error, s, scratch, tiny_avatar};
 
 #[path = "../../../tools/browser.rs"]
 mod browser;
-use browser::Browser;
+use browser::{Browser, ViewServer};
 
-/// A running `mannequin view`, stopped when dropped.
-struct Viewer {
-    child: Child,
-    url: String,
-    port: u16,
+/// The raw response of the viewer on `port` to `request`, sent as is.
+fn raw(port: u16, request: &[u8]) -> String {
+    let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    stream.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    // A server that stops reading early may reset the connection: what came back still counts.
+    let _ = stream.write_all(request);
+    let mut reply = Vec::new();
+    let _ = stream.read_to_end(&mut reply);
+    String::from_utf8_lossy(&reply).into_owned()
 }
 
-impl Viewer {
-    fn start(args: &[&str]) -> Self {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_mannequin"))
-            .arg("view")
-            .args(args)
-            .args(["--port", "0"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap();
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
-        let url = line
-            .split_whitespace()
-            .find(|w| w.starts_with("http://"))
-            .unwrap_or_else(|| panic!("no URL in {line}"));
-        let url = url.trim_end_matches('/').to_string();
-        let port = url.rsplit(':').next().unwrap().parse().unwrap();
-        Viewer { child, url, port }
-    }
-
-    /// The raw response to `request`, sent as is.
-    fn raw(&self, request: &[u8]) -> String {
-        let mut stream = TcpStream::connect(("127.0.0.1", self.port)).unwrap();
-        stream.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
-        // A server that stops reading early may reset the connection: what came back still counts.
-        let _ = stream.write_all(request);
-        let mut reply = Vec::new();
-        let _ = stream.read_to_end(&mut reply);
-        String::from_utf8_lossy(&reply).into_owned()
-    }
-
-    fn get(&self, target: &str) -> String {
-        self.raw(format!("GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n\r\n", self.port).as_bytes())
-    }
-}
-
-impl Drop for Viewer {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+fn get(port: u16, target: &str) -> String {
+    raw(port, format!("GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n").as_bytes())
 }
 
 fn status(reply: &str) -> u16 {
@@ -102,14 +66,14 @@ fn the_server_refuses_everything_outside_the_folder() {
         "-o",
         s(&inside.join("walk.glb")),
     ]));
-    let viewer = Viewer::start(&[s(&inside)]);
+    let viewer = ViewServer::start(&[s(&inside)]);
 
-    let page = viewer.get("/");
+    let page = get(viewer.port, "/");
     assert_eq!(status(&page), 200, "{page}");
     assert!(page.contains("viewer.js"));
-    let glb = viewer.get("/files/walk.glb");
+    let glb = get(viewer.port, "/files/walk.glb");
     assert_eq!(status(&glb), 200);
-    assert!(viewer.get("/scene.json").contains("/files/walk.glb"));
+    assert!(get(viewer.port, "/scene.json").contains("/files/walk.glb"));
 
     let refused = [
         ("/files/../secret/key.txt", 403),
@@ -127,7 +91,7 @@ fn the_server_refuses_everything_outside_the_folder() {
         ("/etc/passwd", 404),
     ];
     for (target, code) in refused {
-        let reply = viewer.get(target);
+        let reply = get(viewer.port, target);
         assert_eq!(status(&reply), code, "{target}: {reply}");
         assert!(!reply.contains("secret\n") || reply.contains("only"), "{target} leaked: {reply}");
     }
@@ -138,16 +102,16 @@ fn the_server_refuses_everything_outside_the_folder() {
         format!("DELETE /files/walk.glb HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n"),
     ];
     for request in &writes {
-        assert_eq!(status(&viewer.raw(request.as_bytes())), 405, "{request}");
+        assert_eq!(status(&raw(viewer.port, request.as_bytes())), 405, "{request}");
     }
     assert!(!inside.join("new.txt").exists() && inside.join("walk.glb").exists());
     let with_body =
         format!("GET /files/walk.glb HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Length: 5\r\n\r\nhello");
-    assert_eq!(status(&viewer.raw(with_body.as_bytes())), 413);
+    assert_eq!(status(&raw(viewer.port, with_body.as_bytes())), 413);
     let huge = format!("GET /{} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n", "a".repeat(20_000));
-    assert_eq!(status(&viewer.raw(huge.as_bytes())), 431);
+    assert_eq!(status(&raw(viewer.port, huge.as_bytes())), 431);
     let rebound = "GET /files/walk.glb HTTP/1.1\r\nHost: attacker.example\r\n\r\n";
-    assert_eq!(status(&viewer.raw(rebound.as_bytes())), 403);
+    assert_eq!(status(&raw(viewer.port, rebound.as_bytes())), 403);
 
     // Loopback only: the machine's own outward address (where it has one) is not served.
     let outward = UdpSocket::bind("0.0.0.0:0")
@@ -273,7 +237,7 @@ fn a_dressed_walk_plays_in_the_browser() {
         .output()
         .unwrap();
     ok(o);
-    let viewer = Viewer::start(&[s(&out)]);
+    let viewer = ViewServer::start(&[s(&out)]);
     let Some(mut browser) = open(&viewer.url, &camera_json, size) else { return };
     let layers = browser.eval("window.mannequin.layers");
     assert!(layers.as_array().is_some_and(|l| l.len() >= 3), "body and two garments: {layers}");
@@ -328,7 +292,7 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
     ok(mannequin(&["motion", "walk", "--seconds", "4", "--fps", "30", "-o", s(&walk4)]));
     ok(mannequin(&["motion", "walk", "--seconds", "2", "--fps", "30", "-o", s(&walk2)]));
     let motions = format!("{},{}", s(&walk4), s(&walk2));
-    let viewer = Viewer::start(&[s(&model), "--data", s(&data), "--motion", &motions]);
+    let viewer = ViewServer::start(&[s(&model), "--data", s(&data), "--motion", &motions]);
     let Some(mut browser) = open(&viewer.url, &camera_json, size) else { return };
     // The first novel view `eval` rendered, beside its ground truth from the dataset.
     let compare = browser.eval(

@@ -64,7 +64,7 @@ impl Site {
         let is_avatar = full.is_dir() && full.join("avatar.json").is_file();
         let mut extra: Value = json!({});
         if is_avatar {
-            extra["motions"] = site.add_avatar(&full, motions, &mut layers)?;
+            extra["motions"] = site.add_avatar(&full, &files, motions, &mut layers)?;
             if let Some(data) = data {
                 extra["compare"] = site.add_compare(&full, data)?;
             }
@@ -100,16 +100,22 @@ impl Site {
 
     /// The avatar's skinned mesh and its Gaussians skinned to the same skeleton, and a glTF of
     /// the mesh per motion the page offers: `motions` (the `--motion` files), then the motion
-    /// files in the folder, or a procedural walk when there are none. Returns the motions' names
+    /// files among the folder's `files`, or a procedural walk when there are none. Returns the motions' names
     /// and URLs; the first is the mesh layer's own.
-    fn add_avatar(&mut self, dir: &Path, motions: &[PathBuf], layers: &mut Vec<Layer>) -> Result<Value> {
+    fn add_avatar(
+        &mut self,
+        dir: &Path,
+        files: &[PathBuf],
+        motions: &[PathBuf],
+        layers: &mut Vec<Layer>,
+    ) -> Result<Value> {
         let avatar = Avatar::load(dir, &Device::flex())?;
         let canonical = canonical_pose(&avatar)?;
         let mut named: Vec<(String, Motion)> = Vec::new();
         for p in motions {
             named.push((stem(p), Motion::read(p)?));
         }
-        for p in sorted_files(dir)?.iter().filter(|p| p.extension().is_some_and(|e| e == "npz")) {
+        for p in files.iter().filter(|p| p.extension().is_some_and(|e| e == "npz")) {
             // The avatar's own files are not motions.
             if ["avatar.npz", "checkpoint.npz"].iter().any(|n| p.ends_with(n)) {
                 continue;
