@@ -18,6 +18,8 @@ pub enum GarmentError {
     Cloth(#[from] mannequin_cloth::ClothError),
     #[error(transparent)]
     Io(#[from] mannequin_io::IoError),
+    #[error(transparent)]
+    Data(#[from] mannequin_data::DataError),
 }
 
 impl GarmentError {

@@ -12,6 +12,7 @@ mod garment;
 pub mod jacobian_fit;
 mod layering;
 mod make;
+pub mod ngd;
 mod panel;
 pub mod region;
 mod sewing;

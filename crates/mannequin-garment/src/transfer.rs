@@ -22,6 +22,7 @@ pub struct Dressed<'a> {
     model: &'a BodyModel,
     faces: Vec<[u32; 3]>,
     shaped: ShapedBody,
+    betas: Vec<f32>,
     /// N × J skinning weights.
     pub weights: Vec<f32>,
 }
@@ -46,7 +47,7 @@ impl<'a> Dressed<'a> {
             ));
         }
         let shaped = shape_body(model, betas)?;
-        let mut dressed = Self { garment, model, faces, shaped, weights: Vec::new() };
+        let mut dressed = Self { garment, model, faces, shaped, betas: betas.to_vec(), weights: Vec::new() };
         let rest = dressed.rest();
         dressed.weights = transfer_weights(
             &points(&dressed.shaped.vertices),
@@ -60,6 +61,15 @@ impl<'a> Dressed<'a> {
 
     pub fn garment(&self) -> &'a Garment {
         self.garment
+    }
+
+    pub fn model(&self) -> &'a BodyModel {
+        self.model
+    }
+
+    /// The body's shape parameters.
+    pub fn betas(&self) -> &[f32] {
+        &self.betas
     }
 
     /// Eq. 3.2 at rest (θ = 0): I^g T(β, 0) + D^g.
@@ -76,17 +86,28 @@ impl<'a> Dressed<'a> {
         pose: &[f32],
         transl: &[f32],
     ) -> Result<Vec<([f32; 3], Mat3A)>, GarmentError> {
+        self.skin_with(rest, &self.weights, pose, transl)
+    }
+
+    /// [`Self::skin`] with other weights (N × J): a remeshed garment's, carried from these.
+    pub fn skin_with(
+        &self,
+        rest: &[[f32; 3]],
+        weights: &[f32],
+        pose: &[f32],
+        transl: &[f32],
+    ) -> Result<Vec<([f32; 3], Mat3A)>, GarmentError> {
         let skinning = frame_skinning(self.model, &self.shaped, pose, transl)?;
         let joints = self.model.num_joints();
-        if rest.len() * joints != self.weights.len() {
+        if rest.len() * joints != weights.len() {
             return Err(GarmentError::invalid(
                 "rest",
-                format!("{} vertices; the garment has {}", rest.len(), self.weights.len() / joints.max(1)),
+                format!("{} vertices; the weights are for {}", rest.len(), weights.len() / joints.max(1)),
             ));
         }
         Ok(rest
             .iter()
-            .zip(self.weights.chunks_exact(joints))
+            .zip(weights.chunks_exact(joints))
             .map(|(p, w)| {
                 let (mut m, mut t) = (Mat3A::ZERO, Vec3A::ZERO);
                 for (k, &wk) in w.iter().enumerate() {

@@ -10,6 +10,7 @@ pub mod gltf;
 pub mod gradient;
 pub mod jacobian_field;
 pub mod laplacian;
+pub mod manifold;
 pub mod mass;
 pub mod normals;
 pub mod obj;

@@ -39,6 +39,8 @@ pub enum MeshError {
         "the Poisson system cannot be factored ({0}): the mesh has degenerate faces or parts not connected to the pinned vertex"
     )]
     Poisson(String),
+    #[error("not a manifold mesh: {0}")]
+    NotManifold(String),
 }
 
 impl TriMesh {

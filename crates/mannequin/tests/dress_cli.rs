@@ -202,6 +202,8 @@ fn garment_fit_brings_the_template_closer_to_the_label_maps() {
         "tshirt",
         "--iters",
         "60",
+        "--normal-weight",
+        "2",
         "--downscale",
         "1",
         "--out",
@@ -215,8 +217,38 @@ fn garment_fit_brings_the_template_closer_to_the_label_maps() {
     );
     println!("mask IoU {before:.3} → {after:.3}");
     assert!(after > before + 0.01, "mask IoU {before} → {after}");
+    // Against the synthetic ground-truth garment meshes (simulated cloth, not the template), on
+    // the frames it was fitted to.
+    let chamfer = |when: &str| report["geometry"][when]["train"]["chamfer_cm"].as_f64().unwrap();
+    println!("Chamfer {:.3} → {:.3} cm", chamfer("before"), chamfer("after"));
+    assert!(
+        chamfer("after") < chamfer("before") - 0.05,
+        "Chamfer {} → {}",
+        chamfer("before"),
+        chamfer("after")
+    );
     let mesh = mannequin_mesh::read_obj(out.join("garment.obj")).unwrap();
     assert!(mesh.vertex_count() > 1000, "{} vertices", mesh.vertex_count());
+    // Pants fitted to the T-shirt's label maps: warned about after the first pass, not silent.
+    let mismatch = mannequin(&[
+        "garment",
+        "fit",
+        "--data",
+        s(&data),
+        "--category",
+        "pants",
+        "--label",
+        "tshirt",
+        "--iters",
+        "10",
+        "--downscale",
+        "1",
+        "--out",
+        s(&dir.join("mismatch")),
+    ]);
+    let log = String::from_utf8_lossy(&mismatch.stderr);
+    assert!(mismatch.status.success(), "{log}");
+    assert!(log.contains("WARN") && log.contains("may not mark a garment of category pants"), "{log}");
     one_line_error(
         &mannequin(&[
             "garment",

@@ -1,0 +1,188 @@
+//! NGD's garment reconstruction loop (seed 002, §2–3): the base garment's static Jacobian field
+//! integrated by the Poisson solve, posed by skinning, rendered against each training frame's
+//! label map and normal map, and moved by Adam. [`Breakdown`] keeps where the time goes.
+
+use std::time::Instant;
+
+use mannequin_data::Camera;
+use mannequin_data::rng::SplitMix64;
+use mannequin_mesh::TriMesh;
+use mannequin_mesh::manifold::check_manifold;
+use serde::Serialize;
+
+use super::loss::{LossParts, image_loss};
+use super::scene::{FramePose, Scene};
+use super::target::Target;
+use crate::error::GarmentError;
+use crate::jacobian_fit::JacobianFieldFit;
+use crate::transfer::Dressed;
+
+/// The optimisation's settings; NGD's terms can each be switched off for the ablations.
+#[derive(Debug, Clone, Serialize)]
+pub struct Settings {
+    /// Optimisation steps, one training frame each.
+    pub steps: usize,
+    /// Adam's step size on the Jacobians.
+    pub rate: f64,
+    /// λ of the Jacobian regulariser λ Σ ‖M_t − I‖² (0: none).
+    pub regulariser: f64,
+    /// γ of the vertex noise (Eqs. 11–12), metres (0: none).
+    pub noise: f64,
+    /// The normal loss's weight against the mask loss (0: masks only).
+    pub normal_weight: f64,
+    /// Seeds the frame order and the noise.
+    pub seed: u64,
+}
+
+/// One training frame: its targets, camera and body pose.
+pub struct TrainingFrame {
+    pub target: Target,
+    pub camera: Camera,
+    pub pose: FramePose,
+}
+
+/// What one step saw: the frame (an index into the training frames), its losses and the mask IoU
+/// of the garment it drew (before the step moved it).
+#[derive(Debug, Clone, Copy)]
+pub struct StepReport {
+    pub frame: usize,
+    pub losses: LossParts,
+    pub mask_iou: f64,
+}
+
+/// Seconds spent in each phase, summed over the steps taken.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Breakdown {
+    pub poisson_solve: f64,
+    pub skinning: f64,
+    pub rasterise: f64,
+    pub losses: f64,
+    pub backward: f64,
+}
+
+impl Breakdown {
+    fn add(slot: &mut f64, since: Instant) -> Instant {
+        let now = Instant::now();
+        *slot += (now - since).as_secs_f64();
+        now
+    }
+
+    /// Milliseconds per step in each phase.
+    pub fn per_step_ms(&self, steps: usize) -> Self {
+        let k = 1e3 / steps.max(1) as f64;
+        Self {
+            poisson_solve: self.poisson_solve * k,
+            skinning: self.skinning * k,
+            rasterise: self.rasterise * k,
+            losses: self.losses * k,
+            backward: self.backward * k,
+        }
+    }
+}
+
+/// The garment being reconstructed on a dressed body.
+pub struct Reconstruction<'a> {
+    dressed: &'a Dressed<'a>,
+    faces: Vec<[u32; 3]>,
+    weights: Vec<f32>,
+    field: JacobianFieldFit,
+    settings: Settings,
+    rng: SplitMix64,
+    steps_taken: usize,
+    pub breakdown: Breakdown,
+}
+
+impl<'a> Reconstruction<'a> {
+    /// Starts from the dressed garment at rest; refuses a base that is not an oriented manifold
+    /// (the Poisson solve and the boundaries assume one).
+    pub fn new(dressed: &'a Dressed<'a>, settings: Settings) -> Result<Self, GarmentError> {
+        let rest = dressed.rest();
+        let faces = dressed.garment().mesh.faces.clone();
+        check_manifold(&rest, &faces).map_err(|e| GarmentError::invalid("base garment", e.to_string()))?;
+        let field = JacobianFieldFit::new(&rest, &faces)
+            .map_err(|e| GarmentError::invalid("base garment", e.to_string()))?;
+        Ok(Self {
+            dressed,
+            faces,
+            weights: dressed.weights.clone(),
+            field,
+            rng: SplitMix64::new(settings.seed),
+            settings,
+            steps_taken: 0,
+            breakdown: Breakdown::default(),
+        })
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    pub fn steps_taken(&self) -> usize {
+        self.steps_taken
+    }
+
+    /// The garment at rest on the body, as the field integrates it.
+    pub fn rest(&self) -> Vec<[f32; 3]> {
+        self.field.positions().iter().map(|p| p.map(|x| x as f32)).collect()
+    }
+
+    pub fn faces(&self) -> &[[u32; 3]] {
+        &self.faces
+    }
+
+    /// The regulariser's current value.
+    pub fn regulariser(&self) -> f64 {
+        self.field.regulariser(self.settings.regulariser)
+    }
+
+    /// One step on a frame drawn from `frames`.
+    pub fn step(&mut self, frames: &[TrainingFrame]) -> Result<StepReport, GarmentError> {
+        if frames.is_empty() {
+            return Err(GarmentError::invalid("frames", "no training frames"));
+        }
+        let k = self.rng.below(frames.len());
+        let frame = &frames[k];
+        let t0 = Instant::now();
+        let rest = self.rest();
+        let t1 = Breakdown::add(&mut self.breakdown.poisson_solve, t0);
+        let scale = self.settings.noise * (1.0 - self.steps_taken as f64 / self.settings.steps.max(1) as f64);
+        let rng = &mut self.rng;
+        let noise = || -> [f32; 3] {
+            if scale > 0.0 { std::array::from_fn(|_| (scale * rng.normal()) as f32) } else { [0.0; 3] }
+        };
+        let scene =
+            Scene::new(self.dressed, &rest, &self.faces, &self.weights, &frame.pose, &frame.camera, noise)?;
+        let t2 = Breakdown::add(&mut self.breakdown.skinning, t1);
+        let rendered = scene.render(&frame.camera);
+        let t3 = Breakdown::add(&mut self.breakdown.rasterise, t2);
+        let (parts, grad) = image_loss(&rendered.image, &frame.target, self.settings.normal_weight);
+        let t4 = Breakdown::add(&mut self.breakdown.losses, t3);
+        let d_rest = scene.backward(&rendered, &grad, &frame.camera);
+        self.field.step(&d_rest, self.settings.rate, self.settings.regulariser);
+        Breakdown::add(&mut self.breakdown.backward, t4);
+        self.steps_taken += 1;
+        Ok(StepReport { frame: k, losses: parts, mask_iou: frame.target.iou(&rendered.image) })
+    }
+
+    /// The garment's mask IoU against each of `frames`' label maps.
+    pub fn mask_iou(&self, frames: &[TrainingFrame]) -> Result<Vec<f64>, GarmentError> {
+        let rest = self.rest();
+        frames
+            .iter()
+            .map(|f| {
+                let scene =
+                    Scene::new(self.dressed, &rest, &self.faces, &self.weights, &f.pose, &f.camera, || {
+                        [0.0; 3]
+                    })?;
+                Ok(f.target.iou(&scene.render(&f.camera).image))
+            })
+            .collect()
+    }
+
+    /// The garment posed in `pose`, as a mesh (for evaluation and export).
+    pub fn posed(&self, pose: &FramePose) -> Result<TriMesh, GarmentError> {
+        let rest = self.rest();
+        let skinned = self.dressed.skin_with(&rest, &self.weights, &pose.pose, &pose.transl)?;
+        Ok(TriMesh::new(skinned.into_iter().map(|(p, _)| p).collect(), self.faces.clone()))
+    }
+}
