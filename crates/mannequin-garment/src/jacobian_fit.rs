@@ -16,11 +16,15 @@ const BETA2: f64 = 0.999;
 pub struct JacobianFieldFit {
     solve: PoissonSolve,
     jacobians: Vec<Jacobian>,
+    pinned: usize,
     pin: [f64; 3],
     pub field: Vec<Jacobian>,
-    first: Vec<Jacobian>,
-    second: Vec<Jacobian>,
+    pub first: Vec<Jacobian>,
+    pub second: Vec<Jacobian>,
     steps: i32,
+    /// Per face, the sum of the loss gradient's norms ‖∂ℓ/∂M_t‖ since the last
+    /// [`Self::take_gradient_norms`] (what adaptive remeshing selects faces by).
+    gradient_norms: Vec<f64>,
 }
 
 impl JacobianFieldFit {
@@ -36,17 +40,60 @@ impl JacobianFieldFit {
         Ok(Self {
             solve: PoissonSolve::new(rest, faces, pinned)?,
             jacobians: rest_jacobians(rest, faces),
+            pinned,
             pin: rest.get(pinned).map_or([0.0; 3], |p| p.map(f64::from)),
             field: vec![IDENTITY; f],
             first: vec![[[0.0; 3]; 3]; f],
             second: vec![[[0.0; 3]; 3]; f],
             steps: 0,
+            gradient_norms: vec![0.0; f],
         })
+    }
+
+    /// The fit carried to a new base mesh `rest`/`faces` (a remeshing of the old one, its old
+    /// vertices first): the same pinned vertex, with the field and Adam's moments given per new
+    /// face, and Adam's step count kept.
+    pub fn remeshed(
+        &self,
+        rest: &[[f32; 3]],
+        faces: &[[u32; 3]],
+        field: Vec<Jacobian>,
+        first: Vec<Jacobian>,
+        second: Vec<Jacobian>,
+    ) -> Result<Self, MeshError> {
+        Ok(Self {
+            solve: PoissonSolve::new(rest, faces, self.pinned)?,
+            jacobians: rest_jacobians(rest, faces),
+            pinned: self.pinned,
+            pin: self.pin,
+            field,
+            first,
+            second,
+            steps: self.steps,
+            gradient_norms: vec![0.0; faces.len()],
+        })
+    }
+
+    /// The per-face gradient norms summed since the last call, and a fresh start.
+    pub fn take_gradient_norms(&mut self) -> Vec<f64> {
+        let zero = vec![0.0; self.gradient_norms.len()];
+        std::mem::replace(&mut self.gradient_norms, zero)
     }
 
     /// The garment's rest positions the field integrates to.
     pub fn positions(&self) -> Vec<[f64; 3]> {
         self.solve.solve(&deform(&self.field, &self.jacobians), self.pin)
+    }
+
+    /// The positions the field plus `dynamic` (per face, NGD's J^D for one pose) integrates to.
+    pub fn positions_with(&self, dynamic: &[Jacobian]) -> Vec<[f64; 3]> {
+        let field: Vec<Jacobian> = self
+            .field
+            .iter()
+            .zip(dynamic)
+            .map(|(s, d)| std::array::from_fn(|i| std::array::from_fn(|k| s[i][k] + d[i][k])))
+            .collect();
+        self.solve.solve(&deform(&field, &self.jacobians), self.pin)
     }
 
     /// λ Σ_t ‖M_t − I‖².
@@ -60,12 +107,15 @@ impl JacobianFieldFit {
     }
 
     /// One Adam step of rate `rate` on the loss whose gradient with respect to [`Self::positions`]
-    /// is `d_positions`, plus the regulariser at `lambda`.
-    pub fn step(&mut self, d_positions: &[[f64; 3]], rate: f64, lambda: f64) {
+    /// is `d_positions`, plus the regulariser at `lambda`. Returns the loss's gradient with
+    /// respect to each face's matrix (without the regulariser), which a dynamic field added to
+    /// this one shares.
+    pub fn step(&mut self, d_positions: &[[f64; 3]], rate: f64, lambda: f64) -> Vec<Jacobian> {
         let d_field = deform_backward(&self.solve.backward(d_positions), &self.jacobians);
         self.steps += 1;
         let (c1, c2) = (1.0 - BETA1.powi(self.steps), 1.0 - BETA2.powi(self.steps));
         for (t, d) in d_field.iter().enumerate() {
+            self.gradient_norms[t] += d.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
             for i in 0..3 {
                 for k in 0..3 {
                     let g = d[i][k] + 2.0 * lambda * (self.field[t][i][k] - IDENTITY[i][k]);
@@ -76,5 +126,6 @@ impl JacobianFieldFit {
                 }
             }
         }
+        d_field
     }
 }

@@ -28,7 +28,7 @@ pub fn remesh(
     for _ in 0..iterations {
         mesh.split_long_edges(LONG * target);
         mesh.collapse_short_edges(SHORT * target, LONG * target);
-        mesh.flip_to_regular_valence();
+        mesh.flip_to_regular_valence(|_| true);
         mesh.relax();
         for (v, p) in mesh.positions.iter_mut().enumerate() {
             if !mesh.incident[v].is_empty() {
@@ -36,6 +36,28 @@ pub fn remesh(
             }
         }
     }
+    mesh.compact()
+}
+
+/// NGD's adaptive step (§3.2): splits each of `edges` at its midpoint, then flips edges toward
+/// valence 6 (4 on a boundary) where that brings the four vertices involved closer to it, among
+/// the edges at the split ones' ends. No vertex moves (a flip changes the surface only where its
+/// two faces are not coplanar); the old vertices keep their indices and the new ones follow.
+pub fn split_and_flip(
+    positions: &[[f32; 3]],
+    faces: &[[u32; 3]],
+    edges: &[[u32; 2]],
+) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    let mut mesh = Working::new(positions, faces);
+    let mut touched = vec![false; positions.len()];
+    for &[a, b] in edges {
+        if mesh.split(a, b).is_some() {
+            touched[a as usize] = true;
+            touched[b as usize] = true;
+        }
+    }
+    touched.resize(mesh.positions.len(), true);
+    mesh.flip_to_regular_valence(|(a, b)| touched[a as usize] || touched[b as usize]);
     mesh.compact()
 }
 
@@ -119,25 +141,7 @@ impl Working {
         while !long_edges.is_empty() {
             let mut next = Vec::new();
             for ((a, b), _) in long_edges {
-                let around = self.edge_faces(a, b);
-                if around.is_empty() || around.len() > 2 {
-                    continue;
-                }
-                let m = self.positions.len() as u32;
-                self.positions.push(0.5 * (self.positions[a as usize] + self.positions[b as usize]));
-                self.incident.push(Vec::new());
-                for f in around {
-                    let tri = self.faces[f as usize];
-                    let c = self.opposite(f, a, b);
-                    let g = self.faces.len() as u32;
-                    self.faces.push(tri.map(|v| if v == a { m } else { v }));
-                    self.alive.push(true);
-                    self.faces[f as usize] = tri.map(|v| if v == b { m } else { v });
-                    self.incident[b as usize].retain(|&h| h != f);
-                    self.incident[b as usize].push(g);
-                    self.incident[c as usize].push(g);
-                    self.incident[m as usize].extend([f, g]);
-                }
+                let Some(m) = self.split(a, b) else { continue };
                 for e in [(a, m), (m, b)] {
                     let l = self.length(e);
                     if l > long {
@@ -147,6 +151,31 @@ impl Working {
             }
             long_edges = next;
         }
+    }
+
+    /// Splits edge a–b at its midpoint (each face on it into two); the new vertex, or None where
+    /// the edge is gone or has more than two faces.
+    fn split(&mut self, a: u32, b: u32) -> Option<u32> {
+        let around = self.edge_faces(a, b);
+        if around.is_empty() || around.len() > 2 {
+            return None;
+        }
+        let m = self.positions.len() as u32;
+        self.positions.push(0.5 * (self.positions[a as usize] + self.positions[b as usize]));
+        self.incident.push(Vec::new());
+        for f in around {
+            let tri = self.faces[f as usize];
+            let c = self.opposite(f, a, b);
+            let g = self.faces.len() as u32;
+            self.faces.push(tri.map(|v| if v == a { m } else { v }));
+            self.alive.push(true);
+            self.faces[f as usize] = tri.map(|v| if v == b { m } else { v });
+            self.incident[b as usize].retain(|&h| h != f);
+            self.incident[b as usize].push(g);
+            self.incident[c as usize].push(g);
+            self.incident[m as usize].extend([f, g]);
+        }
+        Some(m)
     }
 
     fn collapse_short_edges(&mut self, short: f32, long: f32) {
@@ -224,8 +253,9 @@ impl Working {
         self.positions[keep as usize] = at;
     }
 
-    fn flip_to_regular_valence(&mut self) {
-        for (a, b) in self.edges() {
+    /// Flips the edges `consider` accepts toward regular valence.
+    fn flip_to_regular_valence(&mut self, consider: impl Fn((u32, u32)) -> bool) {
+        for (a, b) in self.edges().into_iter().filter(|&e| consider(e)) {
             let around = self.edge_faces(a, b);
             let [f, g] = around[..] else { continue };
             let (c, d) = (self.opposite(f, a, b), self.opposite(g, a, b));
@@ -371,5 +401,51 @@ mod tests {
         // Two circles; the chords of a 2 cm polygon are within 0.2 % of the circle.
         let expected = 2.0 * std::f32::consts::TAU * radius;
         assert!((circumference - expected).abs() < 0.01 * expected, "{circumference} vs {expected}");
+    }
+
+    /// NGD's adaptive step on a flat grid with a boundary: the chosen edges are split, every old
+    /// vertex stays where it was, the result is still an oriented manifold with one boundary loop
+    /// of the same length, and the area is unchanged (flat, so flips cannot change it).
+    #[test]
+    fn split_and_flip_keeps_a_manifold_and_its_boundary() {
+        let n = 8u32;
+        let positions: Vec<[f32; 3]> =
+            (0..=n).flat_map(|y| (0..=n).map(move |x| [x as f32 * 0.1, y as f32 * 0.1, 0.0])).collect();
+        let at = |x: u32, y: u32| y * (n + 1) + x;
+        let faces: Vec<[u32; 3]> = (0..n)
+            .flat_map(|y| {
+                (0..n).flat_map(move |x| {
+                    [[at(x, y), at(x + 1, y), at(x + 1, y + 1)], [at(x, y), at(x + 1, y + 1), at(x, y + 1)]]
+                })
+            })
+            .collect();
+        // Every edge of the faces in the lower-left quarter, boundary edges among them.
+        let chosen: Vec<[u32; 2]> = edges(&faces)
+            .into_iter()
+            .filter(|&[a, b]| [a, b].iter().all(|&v| v % (n + 1) <= n / 2 && v / (n + 1) <= n / 2))
+            .collect();
+        let (new_positions, new_faces) = split_and_flip(&positions, &faces, &chosen);
+        assert_eq!(new_positions.len(), positions.len() + chosen.len());
+        assert_eq!(&new_positions[..positions.len()], &positions[..]);
+        crate::manifold::check_manifold(&new_positions, &new_faces).unwrap();
+        let loops = crate::adjacency::boundary_loops(&new_faces);
+        assert_eq!(loops.len(), 1);
+        let perimeter: f32 = boundary_edges(&new_faces)
+            .iter()
+            .map(|&(a, b)| {
+                Vec3::from(new_positions[a as usize]).distance(Vec3::from(new_positions[b as usize]))
+            })
+            .sum();
+        assert!((perimeter - 3.2).abs() < 1e-5, "perimeter {perimeter}");
+        let area: f32 =
+            new_faces.iter().map(|&t| crate::normals::face_area_normal(&new_positions, t).z * 0.5).sum();
+        assert!((area - 0.64).abs() < 1e-5, "area {area} (a negative share means a face turned over)");
+        let shortest = edges(&new_faces)
+            .iter()
+            .map(|&[a, b]| {
+                Vec3::from(new_positions[a as usize]).distance(Vec3::from(new_positions[b as usize]))
+            })
+            .fold(f32::INFINITY, f32::min);
+        assert!((shortest - 0.05).abs() < 1e-6, "the split edges' halves are 5 cm: {shortest}");
     }
 }

@@ -13,7 +13,9 @@ use anyhow::{Context, Result, bail};
 use mannequin_data::metrics::geometry::{GeometryMetrics, geometry_metrics};
 use mannequin_data::{Dataset, Split, layout};
 use mannequin_garment::Dressed;
-use mannequin_garment::ngd::{FramePose, Reconstruction, Settings, Target, TrainingFrame};
+use mannequin_garment::ngd::{
+    DynamicSettings, FramePose, Reconstruction, RemeshSchedule, Settings, Target, TrainingFrame,
+};
 use mannequin_mesh::TriMesh;
 
 use crate::body::load_body;
@@ -62,6 +64,17 @@ pub struct FitArgs {
     /// 0 fits the masks alone. Unused when the dataset has no normal maps.
     #[arg(long, default_value_t = 0.0)]
     normal_weight: f64,
+    /// NGD's dynamic field (§3.1): an MLP on the pose's first principal components adds a
+    /// pose-dependent part to the Jacobians; 0 components: the static field alone.
+    #[arg(long, default_value_t = 4)]
+    pose_components: usize,
+    /// Adam's step size on the dynamic field's network.
+    #[arg(long, default_value_t = 1e-3)]
+    network_rate: f64,
+    /// Steps between NGD's adaptive remeshings (§3.2: the faces with the largest gradients are
+    /// split, finer as the fit goes); 0: none.
+    #[arg(long, default_value_t = 100)]
+    remesh_every: usize,
     /// Images are read at 1/N of their size.
     #[arg(long, default_value_t = 2)]
     downscale: usize,
@@ -114,9 +127,14 @@ pub fn fit(args: FitArgs) -> Result<()> {
         regulariser: args.regulariser,
         noise: args.noise,
         normal_weight: args.normal_weight,
+        dynamic: (args.pose_components > 0)
+            .then(|| DynamicSettings { components: args.pose_components, rate: args.network_rate }),
+        remesh: (args.remesh_every > 0)
+            .then(|| RemeshSchedule { every: args.remesh_every, ..Default::default() }),
         seed: args.seed,
     };
-    let mut fit = Reconstruction::new(&dressed, settings)?;
+    let poses: Vec<Vec<f32>> = frames.iter().map(|f| f.pose.pose.clone()).collect();
+    let mut fit = Reconstruction::new(&dressed, settings, &poses)?;
     let evaluation = Evaluation::new(&args.data, &dataset, &args.category)?;
     let before = fit.mask_iou(&frames)?;
     let geometry_before = evaluation.measure(&fit)?;
@@ -146,12 +164,9 @@ pub fn fit(args: FitArgs) -> Result<()> {
     let after = fit.mask_iou(&frames)?;
     let geometry_after = evaluation.measure(&fit)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    let mesh = TriMesh {
-        positions: fit.rest(),
-        faces: fit.faces().to_vec(),
-        uv: garment.mesh.uv.clone(),
-        colors: None,
-    };
+    // The template's UVs hold while the topology is the template's.
+    let uv = garment.mesh.uv.clone().filter(|_| fit.faces().len() == garment.mesh.faces.len());
+    let mesh = TriMesh { positions: fit.rest(), faces: fit.faces().to_vec(), uv, colors: None };
     crate::body::write_mesh(&args.out.join("garment.obj"), &mesh)?;
     let report = serde_json::json!({
         "category": args.category,

@@ -24,35 +24,47 @@ impl KdTree {
 
     /// The input index of the nearest point and its squared distance (`None` for an empty tree).
     pub fn nearest(&self, q: DVec3) -> Option<(usize, f64)> {
-        if self.points.is_empty() {
-            return None;
-        }
-        let mut best = (usize::MAX, f64::INFINITY);
-        self.search(q, 0, self.points.len(), &mut best);
-        Some((self.order[best.0] as usize, best.1))
+        self.k_nearest(q, 1).first().copied()
     }
 
-    fn search(&self, q: DVec3, lo: usize, hi: usize, best: &mut (usize, f64)) {
+    /// The input indices of the `k` nearest points (fewer if the tree holds fewer) and their
+    /// squared distances, nearest first.
+    pub fn k_nearest(&self, q: DVec3, k: usize) -> Vec<(usize, f64)> {
+        let mut best = Vec::with_capacity(k + 1);
+        if k > 0 {
+            self.search(q, 0, self.points.len(), k, &mut best);
+        }
+        best.into_iter().map(|(i, d)| (self.order[i] as usize, d)).collect()
+    }
+
+    /// The squared distance a point must beat to enter `best`.
+    fn bound(best: &[(usize, f64)], k: usize) -> f64 {
+        if best.len() < k { f64::INFINITY } else { best[k - 1].1 }
+    }
+
+    fn offer(best: &mut Vec<(usize, f64)>, k: usize, i: usize, d: f64) {
+        if d < Self::bound(best, k) {
+            let at = best.partition_point(|&(_, e)| e <= d);
+            best.insert(at, (i, d));
+            best.truncate(k);
+        }
+    }
+
+    fn search(&self, q: DVec3, lo: usize, hi: usize, k: usize, best: &mut Vec<(usize, f64)>) {
         if hi - lo <= LEAF {
             for i in lo..hi {
-                let d = self.points[i].distance_squared(q);
-                if d < best.1 {
-                    *best = (i, d);
-                }
+                Self::offer(best, k, i, self.points[i].distance_squared(q));
             }
             return;
         }
         let mid = lo + (hi - lo) / 2;
         let ax = self.axis[mid] as usize;
         let diff = q[ax] - self.points[mid][ax];
-        let d = self.points[mid].distance_squared(q);
-        if d < best.1 {
-            *best = (mid, d);
-        }
+        Self::offer(best, k, mid, self.points[mid].distance_squared(q));
         let (near, far) = if diff < 0.0 { ((lo, mid), (mid + 1, hi)) } else { ((mid + 1, hi), (lo, mid)) };
-        self.search(q, near.0, near.1, best);
-        if diff * diff < best.1 {
-            self.search(q, far.0, far.1, best);
+        self.search(q, near.0, near.1, k, best);
+        if diff * diff < Self::bound(best, k) {
+            self.search(q, far.0, far.1, k, best);
         }
     }
 }
@@ -101,5 +113,22 @@ mod tests {
             assert_eq!(points[i].distance_squared(q), d);
         }
         assert!(KdTree::new(&[]).nearest(DVec3::ZERO).is_none());
+    }
+
+    #[test]
+    fn k_nearest_matches_brute_force() {
+        let mut r = crate::rng::SplitMix64::new(7);
+        let mut pt = || DVec3::new(r.normal(), r.uniform(), r.normal() * 2.0);
+        let points: Vec<DVec3> = (0..1500).map(|_| pt()).collect();
+        let tree = KdTree::new(&points);
+        for _ in 0..200 {
+            let q = pt();
+            let mut brute: Vec<f64> = points.iter().map(|p| p.distance_squared(q)).collect();
+            brute.sort_by(f64::total_cmp);
+            let found = tree.k_nearest(q, 5);
+            assert_eq!(found.iter().map(|x| x.1).collect::<Vec<_>>(), brute[..5]);
+            assert!(found.iter().all(|&(i, d)| points[i].distance_squared(q) == d));
+        }
+        assert_eq!(KdTree::new(&points[..3]).k_nearest(DVec3::ZERO, 5).len(), 3);
     }
 }

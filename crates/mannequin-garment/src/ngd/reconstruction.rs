@@ -10,7 +10,10 @@ use mannequin_mesh::TriMesh;
 use mannequin_mesh::manifold::check_manifold;
 use serde::Serialize;
 
+use super::dynamic_field::DynamicField;
 use super::loss::{LossParts, image_loss};
+use super::pose_code::PoseCode;
+use super::remesh::{RemeshSchedule, remesh_and_carry, selected_edges};
 use super::scene::{FramePose, Scene};
 use super::target::Target;
 use crate::error::GarmentError;
@@ -30,8 +33,26 @@ pub struct Settings {
     pub noise: f64,
     /// The normal loss's weight against the mask loss (0: masks only).
     pub normal_weight: f64,
+    /// The dynamic field J^D (§3.1): the pose code's length and Adam's rate on the network; None
+    /// for the static field alone.
+    pub dynamic: Option<DynamicSettings>,
+    /// Adaptive remeshing (§3.2), or none.
+    pub remesh: Option<RemeshSchedule>,
     /// Seeds the frame order and the noise.
     pub seed: u64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct DynamicSettings {
+    /// k, the principal components of the pose (NGD: 4 for geometry).
+    pub components: usize,
+    pub rate: f64,
+}
+
+impl Default for DynamicSettings {
+    fn default() -> Self {
+        Self { components: 4, rate: 1e-3 }
+    }
 }
 
 /// One training frame: its targets, camera and body pose.
@@ -53,11 +74,13 @@ pub struct StepReport {
 /// Seconds spent in each phase, summed over the steps taken.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Breakdown {
+    pub jacobian_mlp: f64,
     pub poisson_solve: f64,
     pub skinning: f64,
     pub rasterise: f64,
     pub losses: f64,
     pub backward: f64,
+    pub remesh: f64,
 }
 
 impl Breakdown {
@@ -71,11 +94,13 @@ impl Breakdown {
     pub fn per_step_ms(&self, steps: usize) -> Self {
         let k = 1e3 / steps.max(1) as f64;
         Self {
+            jacobian_mlp: self.jacobian_mlp * k,
             poisson_solve: self.poisson_solve * k,
             skinning: self.skinning * k,
             rasterise: self.rasterise * k,
             losses: self.losses * k,
             backward: self.backward * k,
+            remesh: self.remesh * k,
         }
     }
 }
@@ -83,9 +108,13 @@ impl Breakdown {
 /// The garment being reconstructed on a dressed body.
 pub struct Reconstruction<'a> {
     dressed: &'a Dressed<'a>,
+    /// The base garment at rest, remeshed as the fit goes.
+    base: Vec<[f32; 3]>,
     faces: Vec<[u32; 3]>,
     weights: Vec<f32>,
     field: JacobianFieldFit,
+    /// The dynamic field and the pose code it reads, if the settings ask for one.
+    dynamic: Option<(DynamicField, PoseCode)>,
     settings: Settings,
     rng: SplitMix64,
     steps_taken: usize,
@@ -93,16 +122,30 @@ pub struct Reconstruction<'a> {
 }
 
 impl<'a> Reconstruction<'a> {
-    /// Starts from the dressed garment at rest; refuses a base that is not an oriented manifold
-    /// (the Poisson solve and the boundaries assume one).
-    pub fn new(dressed: &'a Dressed<'a>, settings: Settings) -> Result<Self, GarmentError> {
+    /// Starts from the dressed garment at rest, with the pose code (if any) taken over
+    /// `training_poses` (72 values each); refuses a base that is not an oriented manifold (the
+    /// Poisson solve and the boundaries assume one).
+    pub fn new(
+        dressed: &'a Dressed<'a>,
+        settings: Settings,
+        training_poses: &[Vec<f32>],
+    ) -> Result<Self, GarmentError> {
         let rest = dressed.rest();
         let faces = dressed.garment().mesh.faces.clone();
         check_manifold(&rest, &faces).map_err(|e| GarmentError::invalid("base garment", e.to_string()))?;
         let field = JacobianFieldFit::new(&rest, &faces)
             .map_err(|e| GarmentError::invalid("base garment", e.to_string()))?;
+        let dynamic = settings.dynamic.as_ref().map(|d| {
+            let code = PoseCode::fit(
+                &training_poses.iter().map(|p| body_pose(p).to_vec()).collect::<Vec<_>>(),
+                d.components,
+            );
+            (DynamicField::new(code.len(), &rest, &faces, settings.seed), code)
+        });
         Ok(Self {
             dressed,
+            dynamic,
+            base: rest,
             faces,
             weights: dressed.weights.clone(),
             field,
@@ -121,9 +164,19 @@ impl<'a> Reconstruction<'a> {
         self.steps_taken
     }
 
-    /// The garment at rest on the body, as the field integrates it.
+    /// The garment at rest on the body, as the static field integrates it.
     pub fn rest(&self) -> Vec<[f32; 3]> {
-        self.field.positions().iter().map(|p| p.map(|x| x as f32)).collect()
+        to_f32(&self.field.positions())
+    }
+
+    /// The garment at rest in the shape it takes in `pose` (the dynamic field's, if any).
+    fn rest_for(&self, pose: &FramePose) -> Vec<[f32; 3]> {
+        match &self.dynamic {
+            Some((network, code)) => {
+                to_f32(&self.field.positions_with(&network.forward(&code.encode(body_pose(&pose.pose))).0))
+            }
+            None => self.rest(),
+        }
     }
 
     pub fn faces(&self) -> &[[u32; 3]] {
@@ -143,7 +196,15 @@ impl<'a> Reconstruction<'a> {
         let k = self.rng.below(frames.len());
         let frame = &frames[k];
         let t0 = Instant::now();
-        let rest = self.rest();
+        let dynamic = self
+            .dynamic
+            .as_ref()
+            .map(|(network, code)| network.forward(&code.encode(body_pose(&frame.pose.pose))));
+        let t0 = Breakdown::add(&mut self.breakdown.jacobian_mlp, t0);
+        let rest = match &dynamic {
+            Some((m, _)) => to_f32(&self.field.positions_with(m)),
+            None => self.rest(),
+        };
         let t1 = Breakdown::add(&mut self.breakdown.poisson_solve, t0);
         let scale = self.settings.noise * (1.0 - self.steps_taken as f64 / self.settings.steps.max(1) as f64);
         let rng = &mut self.rng;
@@ -158,18 +219,63 @@ impl<'a> Reconstruction<'a> {
         let (parts, grad) = image_loss(&rendered.image, &frame.target, self.settings.normal_weight);
         let t4 = Breakdown::add(&mut self.breakdown.losses, t3);
         let d_rest = scene.backward(&rendered, &grad, &frame.camera);
-        self.field.step(&d_rest, self.settings.rate, self.settings.regulariser);
-        Breakdown::add(&mut self.breakdown.backward, t4);
+        let d_field = self.field.step(&d_rest, self.settings.rate, self.settings.regulariser);
+        let t5 = Breakdown::add(&mut self.breakdown.backward, t4);
+        if let (Some((network, _)), Some((_, activations)), Some(d)) =
+            (self.dynamic.as_mut(), dynamic.as_ref(), self.settings.dynamic.as_ref())
+        {
+            network.step(activations, &d_field, d.rate);
+        }
+        let t5 = Breakdown::add(&mut self.breakdown.jacobian_mlp, t5);
         self.steps_taken += 1;
+        if let Some((alpha, delta)) =
+            self.settings.remesh.as_ref().and_then(|r| r.due(self.steps_taken, self.settings.steps))
+        {
+            self.remesh(alpha, delta)?;
+        }
+        Breakdown::add(&mut self.breakdown.remesh, t5);
         Ok(StepReport { frame: k, losses: parts, mask_iou: frame.target.iou(&rendered.image) })
+    }
+
+    /// Splits the faces that quantile `alpha` and edge length `delta` select (§3.2) and carries
+    /// the fit to the new mesh.
+    fn remesh(&mut self, alpha: f64, delta: f64) -> Result<(), GarmentError> {
+        let norms = self.field.take_gradient_norms();
+        let edges = selected_edges(&self.base, &self.faces, &norms, alpha, delta);
+        if edges.is_empty() {
+            return Ok(());
+        }
+        let joints = self.dressed.model().num_joints();
+        let field = &self.field;
+        let carried = remesh_and_carry(
+            &self.base,
+            &self.faces,
+            &edges,
+            &field.field,
+            [&field.first, &field.second],
+            &self.weights,
+            joints,
+        );
+        check_manifold(&carried.positions, &carried.faces)
+            .map_err(|e| GarmentError::invalid("remeshing", e.to_string()))?;
+        self.field = field
+            .remeshed(&carried.positions, &carried.faces, carried.field, carried.first, carried.second)
+            .map_err(|e| GarmentError::invalid("remeshing", e.to_string()))?;
+        if let Some((network, _)) = self.dynamic.as_mut() {
+            network.set_base(&carried.positions, &carried.faces);
+        }
+        self.base = carried.positions;
+        self.faces = carried.faces;
+        self.weights = carried.weights;
+        Ok(())
     }
 
     /// The garment's mask IoU against each of `frames`' label maps.
     pub fn mask_iou(&self, frames: &[TrainingFrame]) -> Result<Vec<f64>, GarmentError> {
-        let rest = self.rest();
         frames
             .iter()
             .map(|f| {
+                let rest = self.rest_for(&f.pose);
                 let scene =
                     Scene::new(self.dressed, &rest, &self.faces, &self.weights, &f.pose, &f.camera, || {
                         [0.0; 3]
@@ -181,8 +287,18 @@ impl<'a> Reconstruction<'a> {
 
     /// The garment posed in `pose`, as a mesh (for evaluation and export).
     pub fn posed(&self, pose: &FramePose) -> Result<TriMesh, GarmentError> {
-        let rest = self.rest();
+        let rest = self.rest_for(pose);
         let skinned = self.dressed.skin_with(&rest, &self.weights, &pose.pose, &pose.transl)?;
         Ok(TriMesh::new(skinned.into_iter().map(|(p, _)| p).collect(), self.faces.clone()))
     }
+}
+
+fn to_f32(positions: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    positions.iter().map(|p| p.map(|x| x as f32)).collect()
+}
+
+/// The joints' rotations without the root's: a turn of the whole body does not change how a
+/// garment hangs, and in a turning capture it would be the pose's main component.
+fn body_pose(pose: &[f32]) -> &[f32] {
+    pose.get(3..).unwrap_or(&[])
 }
