@@ -9,8 +9,9 @@ use std::collections::HashMap;
 use crate::MeshError;
 use crate::normals::face_area_normal;
 
-/// A face whose area normal is shorter than this (twice its area, m²) counts as degenerate.
-const MIN_DOUBLE_AREA: f32 = 1e-12;
+/// A face whose twice-area is below this share of its longest edge squared (a corner angle of
+/// about 1e-6 rad, or a point) counts as degenerate: its cotangent weights would be unbounded.
+const MIN_SINE: f32 = 1e-6;
 
 /// `Ok` when `positions`/`faces` is an oriented manifold with boundary, else the first fault.
 pub fn check_manifold(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Result<(), MeshError> {
@@ -24,8 +25,11 @@ pub fn check_manifold(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Result<(), 
         if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
             return fault(format!("face {f} repeats a corner ({t:?})"));
         }
-        if face_area_normal(positions, t).length() < MIN_DOUBLE_AREA {
-            return fault(format!("face {f} has no area ({t:?})"));
+        let corner = |k: usize| glam::Vec3::from(positions[t[k] as usize]);
+        let longest = (0..3).map(|k| corner(k).distance_squared(corner((k + 1) % 3))).fold(0.0, f32::max);
+        if face_area_normal(positions, t).length() <= MIN_SINE * longest {
+            let corners = t.map(|v| positions[v as usize]);
+            return fault(format!("face {f} has no area (vertices {t:?} at {corners:?})"));
         }
         for k in 0..3 {
             let edge = (t[k], t[(k + 1) % 3]);

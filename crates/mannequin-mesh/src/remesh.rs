@@ -11,6 +11,12 @@ use crate::TriMesh;
 /// Edge-length bounds relative to the target, Botsch & Kobbelt's 4/3 and 4/5.
 const LONG: f32 = 4.0 / 3.0;
 const SHORT: f32 = 4.0 / 5.0;
+/// An edge is split only if each face on it has twice its area at least this share of the
+/// edge's length squared (an angle of about 3° at the opposite corner of a right triangle).
+const MIN_SPLIT_SINE: f32 = 0.05;
+/// A flip may not make a face whose twice-area is below this share of the new edge's length
+/// squared.
+const MIN_FLIP_SINE: f32 = 1e-3;
 /// A flip or collapse may not turn a face by more than this (cosine of about 60°).
 const MIN_NORMAL_DOT: f32 = 0.5;
 
@@ -51,7 +57,12 @@ pub fn split_and_flip(
     let mut mesh = Working::new(positions, faces);
     let mut touched = vec![false; positions.len()];
     for &[a, b] in edges {
-        if mesh.split(a, b).is_some() {
+        // A sliver's halves would be slivers again, down to faces f32 cannot tell from lines.
+        let sliver = mesh.edge_faces(a, b).into_iter().any(|f| {
+            let area = mesh.normal(mesh.faces[f as usize]).length();
+            area < MIN_SPLIT_SINE * mesh.length((a, b)).powi(2)
+        });
+        if !sliver && mesh.split(a, b).is_some() {
             touched[a as usize] = true;
             touched[b as usize] = true;
         }
@@ -281,10 +292,13 @@ impl Working {
             let (new_f, new_g) = ([c, a, d], [d, b, c]);
             let old = self.normal(self.faces[f as usize]).normalize_or_zero()
                 + self.normal(self.faces[g as usize]).normalize_or_zero();
-            if [new_f, new_g]
-                .iter()
-                .any(|&t| self.normal(t).normalize_or_zero().dot(old.normalize_or_zero()) < MIN_NORMAL_DOT)
-            {
+            // A face with no area (c, d and a corner in line: after a split, the split edge's
+            // ends and its midpoint) has a normal of rounding noise, which may pass the turn test.
+            let flat = MIN_FLIP_SINE * self.length((c, d)).powi(2);
+            if [new_f, new_g].iter().any(|&t| {
+                let n = self.normal(t);
+                n.length() < flat || n.normalize_or_zero().dot(old.normalize_or_zero()) < MIN_NORMAL_DOT
+            }) {
                 continue;
             }
             self.faces[f as usize] = new_f;
@@ -403,14 +417,53 @@ mod tests {
         assert!((circumference - expected).abs() < 0.01 * expected, "{circumference} vs {expected}");
     }
 
-    /// NGD's adaptive step on a flat grid with a boundary: the chosen edges are split, every old
+    /// A fan round a centre (valence 9) whose rim edge 2–3 has been split at vertex 1: flipping
+    /// the spoke 0–1 looks good for valence, but would lay a face along the rim through the
+    /// midpoint, with no area. In several orientations (the rounding noise that is a flat face's
+    /// normal differs with each), no face of the result may be flat.
+    #[test]
+    fn flips_make_no_flat_face() {
+        for k in 0..12 {
+            let turn =
+                glam::Quat::from_axis_angle(Vec3::new(1.0, 0.3 * k as f32, 2.0).normalize(), 0.37 * k as f32);
+            // Away from the origin, as a garment is, so that differences round.
+            let centre = Vec3::new(0.37, -0.21, 0.15);
+            let rim = |i: u32| {
+                let a = i as f32 * std::f32::consts::TAU / 8.0;
+                centre + turn * Vec3::new(0.1 * a.cos(), 0.1 * a.sin(), 0.0)
+            };
+            let mut positions = vec![centre, 0.5 * (rim(0) + rim(1))];
+            positions.extend((0..8).map(rim));
+            let positions: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
+            let mut faces = vec![[0, 2, 1], [0, 1, 3]];
+            faces.extend((1..8).map(|i| [0, 2 + i, 2 + (i + 1) % 8]));
+            let mut mesh = Working::new(&positions, &faces);
+            mesh.flip_to_regular_valence(|_| true);
+            let (p, f) = mesh.compact();
+            for t in &f {
+                let [a, b, c] = t.map(|v| Vec3::from(p[v as usize]));
+                let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+                let sine = (b - a).cross(c - a).length() / longest.powi(2);
+                assert!(sine > 1e-3, "orientation {k}: face {t:?} is flat (twice-area / longest² = {sine})");
+            }
+        }
+    }
+
+    /// NGD's adaptive step on a flat grid with a boundary, turned out of the axes (so that
+    /// rounding gives a flat face a normal of noise): the chosen edges are split, every old
     /// vertex stays where it was, the result is still an oriented manifold with one boundary loop
-    /// of the same length, and the area is unchanged (flat, so flips cannot change it).
+    /// of the same length, and the area is unchanged (flat, so flips cannot change it) with no
+    /// face of (nearly) none.
     #[test]
     fn split_and_flip_keeps_a_manifold_and_its_boundary() {
         let n = 8u32;
-        let positions: Vec<[f32; 3]> =
-            (0..=n).flat_map(|y| (0..=n).map(move |x| [x as f32 * 0.1, y as f32 * 0.1, 0.0])).collect();
+        let turn = glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+        let up = turn * Vec3::Z;
+        let positions: Vec<[f32; 3]> = (0..=n)
+            .flat_map(|y| {
+                (0..=n).map(move |x| (turn * Vec3::new(x as f32 * 0.1, y as f32 * 0.1, 0.0)).to_array())
+            })
+            .collect();
         let at = |x: u32, y: u32| y * (n + 1) + x;
         let faces: Vec<[u32; 3]> = (0..n)
             .flat_map(|y| {
@@ -437,9 +490,12 @@ mod tests {
             })
             .sum();
         assert!((perimeter - 3.2).abs() < 1e-5, "perimeter {perimeter}");
-        let area: f32 =
-            new_faces.iter().map(|&t| crate::normals::face_area_normal(&new_positions, t).z * 0.5).sum();
+        let twice_areas: Vec<f32> =
+            new_faces.iter().map(|&t| crate::normals::face_area_normal(&new_positions, t).dot(up)).collect();
+        let area = twice_areas.iter().sum::<f32>() * 0.5;
         assert!((area - 0.64).abs() < 1e-5, "area {area} (a negative share means a face turned over)");
+        let thinnest = twice_areas.iter().copied().fold(f32::INFINITY, f32::min);
+        assert!(thinnest > 1e-4, "a face with (nearly) no area: twice-area {thinnest}");
         let shortest = edges(&new_faces)
             .iter()
             .map(|&[a, b]| {

@@ -12,10 +12,10 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use mannequin_data::metrics::geometry::{GeometryMetrics, geometry_metrics};
 use mannequin_data::{Dataset, Split, layout};
-use mannequin_garment::Dressed;
 use mannequin_garment::ngd::{
     DynamicSettings, FramePose, Reconstruction, RemeshSchedule, Settings, Target, TrainingFrame,
 };
+use mannequin_garment::{Category, Dressed};
 use mannequin_mesh::TriMesh;
 
 use crate::body::load_body;
@@ -25,6 +25,8 @@ use crate::progress::{JobTimer, bar};
 /// Below this mean mask IoU over the first pass through the frames, the category is probably not
 /// the garment in the label maps (the right template starts near 0.7).
 const MISMATCH_IOU: f64 = 0.5;
+/// The normal loss's weight where the dataset has normal maps.
+const DEFAULT_NORMAL_WEIGHT: f64 = 2.0;
 /// Frames evaluated against the ground truth, at most, per split.
 const EVALUATED_FRAMES: usize = 12;
 /// Surface samples per mesh for Chamfer and normal consistency.
@@ -48,10 +50,10 @@ pub struct FitArgs {
     #[arg(long, default_value = "M")]
     size: String,
     /// Optimisation steps (one training frame each).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 400)]
     iters: usize,
-    /// Adam's step size on the Jacobians.
-    #[arg(long, default_value_t = 0.003)]
+    /// Adam's step size on the static Jacobian field.
+    #[arg(long, default_value_t = 0.01)]
     rate: f64,
     /// The Jacobian regulariser's weight (toward the base shape).
     #[arg(long, default_value_t = 1e-4)]
@@ -61,9 +63,9 @@ pub struct FitArgs {
     #[arg(long, default_value_t = 0.0)]
     noise: f64,
     /// The weight of the normal-map loss (Huber, on the garment's pixels) against the mask loss;
-    /// 0 fits the masks alone. Unused when the dataset has no normal maps.
-    #[arg(long, default_value_t = 0.0)]
-    normal_weight: f64,
+    /// 0 fits the masks alone. Without it: 2 where the dataset has normal maps, else 0.
+    #[arg(long)]
+    normal_weight: Option<f64>,
     /// NGD's dynamic field (§3.1): an MLP on the pose's first principal components adds a
     /// pose-dependent part to the Jacobians; 0 components: the static field alone.
     #[arg(long, default_value_t = 4)]
@@ -94,7 +96,9 @@ pub fn fit(args: FitArgs) -> Result<()> {
     let start = Instant::now();
     let dataset = Dataset::open(&args.data, args.downscale)?;
     let label_name = args.label.as_deref().unwrap_or(&args.category);
-    let label = garment_label(&args.data, label_name)?;
+    let legend = label_legend(&args.data)?;
+    let label = label_index(&args.data, &legend, label_name)?;
+    let outer = outer_labels(&legend, &args.category)?;
     let model = load_body(&args.body)?;
     let train = dataset.split("train")?;
     if train.frames.is_empty() {
@@ -108,27 +112,36 @@ pub fn fit(args: FitArgs) -> Result<()> {
         .enumerate()
         .map(|(k, &f)| {
             let camera = dataset.camera(f).clone();
-            let target = Target::read(&args.data, &camera, f, label)?;
+            let target = Target::read(&args.data, &camera, f, label, &outer)?;
             Ok(TrainingFrame { target, camera, pose: frame_pose(&train, k) })
         })
         .collect::<Result<Vec<_>>>()?;
     let has_normals = frames.iter().all(|f| f.target.normals.is_some());
-    if args.normal_weight > 0.0 && !has_normals {
-        bail!(
-            "{}: --normal-weight {} needs normal maps ({}/normal_%04d.png) for every training frame",
+    let normal_weight = match args.normal_weight {
+        Some(w) if w > 0.0 && !has_normals => bail!(
+            "{}: --normal-weight {w} needs normal maps ({}/normal_%04d.png) for every training frame",
             args.data.display(),
-            args.normal_weight,
             layout::NORMALS
-        );
-    }
+        ),
+        Some(w) => w,
+        None if has_normals => DEFAULT_NORMAL_WEIGHT,
+        None => {
+            tracing::info!(
+                "{}: no normal maps for every training frame ({}/normal_%04d.png): fitting the label maps alone",
+                args.data.display(),
+                layout::NORMALS
+            );
+            0.0
+        }
+    };
     let settings = Settings {
         steps: args.iters,
         rate: args.rate,
         regulariser: args.regulariser,
         noise: args.noise,
-        normal_weight: args.normal_weight,
+        normal_weight,
         dynamic: (args.pose_components > 0)
-            .then(|| DynamicSettings { components: args.pose_components, rate: args.network_rate }),
+            .then_some(DynamicSettings { components: args.pose_components, rate: args.network_rate }),
         remesh: (args.remesh_every > 0)
             .then(|| RemeshSchedule { every: args.remesh_every, ..Default::default() }),
         seed: args.seed,
@@ -173,6 +186,7 @@ pub fn fit(args: FitArgs) -> Result<()> {
         "label": label_name,
         "settings": fit.settings(),
         "frames": train.frames,
+        "faces": { "base": garment.mesh.faces.len(), "fitted": fit.faces().len() },
         "mask_iou_before": before,
         "mask_iou_after": after,
         "mean_mask_iou": { "before": mean(&before), "after": mean(&after) },
@@ -211,20 +225,36 @@ fn frame_pose(split: &Split, k: usize) -> FramePose {
     FramePose { pose: split.poses.pose72(k), transl: split.poses.transl[k] }
 }
 
-/// The index of the label `name` in the dataset's legend (`subject.json`'s `labels`).
-fn garment_label(root: &Path, name: &str) -> Result<u8> {
+/// The dataset's label names (`subject.json`'s `labels`), by index.
+fn label_legend(root: &Path) -> Result<Vec<String>> {
     let path = root.join("subject.json");
     let text = std::fs::read_to_string(&path).with_context(|| {
         format!("{}: the dataset has no label legend (subject.json with \"labels\"); garment fit needs label maps", path.display())
     })?;
     let json: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    let names: Vec<&str> =
-        json["labels"].as_array().into_iter().flatten().filter_map(|v| v.as_str()).collect();
-    match names.iter().position(|n| *n == name) {
+    Ok(json["labels"].as_array().into_iter().flatten().filter_map(|v| v.as_str().map(String::from)).collect())
+}
+
+fn label_index(root: &Path, legend: &[String], name: &str) -> Result<u8> {
+    match legend.iter().position(|n| n == name) {
         Some(i) => Ok(i as u8),
-        None => bail!("{}: labels: no '{name}' among {names:?}", path.display()),
+        None => bail!("{}: labels: no '{name}' among {legend:?}", root.join("subject.json").display()),
     }
+}
+
+/// The labels of garments worn over one of `category`: upper-body garments over a lower-body one.
+/// Where they show, the garment may be behind them, so those pixels say nothing about it.
+fn outer_labels(legend: &[String], category: &str) -> Result<Vec<u8>> {
+    if !Category::named(category)?.is_lower_body() {
+        return Ok(Vec::new());
+    }
+    Ok(legend
+        .iter()
+        .enumerate()
+        .filter(|(_, name)| Category::named(name).is_ok_and(|c| !c.is_lower_body()))
+        .map(|(i, _)| i as u8)
+        .collect())
 }
 
 /// The mean geometry metrics over evaluated frames of the training and test splits.

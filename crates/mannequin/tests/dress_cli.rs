@@ -202,8 +202,8 @@ fn garment_fit_brings_the_template_closer_to_the_label_maps() {
         "tshirt",
         "--iters",
         "60",
-        "--normal-weight",
-        "2",
+        "--remesh-every",
+        "20",
         "--downscale",
         "1",
         "--out",
@@ -229,6 +229,14 @@ fn garment_fit_brings_the_template_closer_to_the_label_maps() {
     );
     let mesh = mannequin_mesh::read_obj(out.join("garment.obj")).unwrap();
     assert!(mesh.vertex_count() > 1000, "{} vertices", mesh.vertex_count());
+    // Remeshing added faces and kept an oriented manifold with the T-shirt's four openings
+    // (neck, hem, two sleeves).
+    let (base, fitted) =
+        (report["faces"]["base"].as_u64().unwrap(), report["faces"]["fitted"].as_u64().unwrap());
+    assert_eq!(fitted as usize, mesh.face_count());
+    assert!(fitted > base, "remeshing added no faces: {base} → {fitted}");
+    mannequin_mesh::manifold::check_manifold(&mesh.positions, &mesh.faces).unwrap();
+    assert_eq!(mannequin_mesh::adjacency::boundary_loops(&mesh.faces).len(), 4);
     // Pants fitted to the T-shirt's label maps: warned about after the first pass, not silent.
     let mismatch = mannequin(&[
         "garment",

@@ -191,10 +191,12 @@ impl DynamicField {
         let width = self.layers[0].inputs;
         let sizes = self.layers.each_ref().map(|l| l.weights.len() + l.out());
         let zero = || sizes.map(|n| vec![0.0f32; n]);
-        d_out
+        // Per chunk, then summed in chunk order: the same sums whatever the threads did.
+        let partial: Vec<[Vec<f32>; 3]> = d_out
             .par_chunks(CHUNK)
             .enumerate()
-            .fold(zero, |mut g, (chunk, d)| {
+            .map(|(chunk, d)| {
+                let mut g = zero();
                 for (k, d) in d.iter().enumerate() {
                     let f = chunk * CHUNK + k;
                     let dy: Vec<f32> = d.iter().flatten().map(|&v| v as f32).collect();
@@ -211,10 +213,11 @@ impl DynamicField {
                 }
                 g
             })
-            .reduce(zero, |mut a, b| {
-                a.iter_mut().zip(&b).for_each(|(x, y)| x.iter_mut().zip(y).for_each(|(u, v)| *u += v));
-                a
-            })
+            .collect();
+        partial.into_iter().fold(zero(), |mut a, b| {
+            a.iter_mut().zip(&b).for_each(|(x, y)| x.iter_mut().zip(y).for_each(|(u, v)| *u += v));
+            a
+        })
     }
 
     /// One Adam step of rate `rate` down the gradient `d_out` of the forward pass `acts`.
@@ -253,8 +256,8 @@ mod tests {
         let (_, acts) = field.forward(&code);
         let grads = field.gradients(&acts, &weights);
         let (mut checked, mut kinks) = (0, 0);
-        for layer in 0..3 {
-            for k in (0..grads[layer].len()).step_by(37) {
+        for (layer, grad) in grads.iter().enumerate() {
+            for k in (0..grad.len()).step_by(37) {
                 let n = field.layers[layer].weights.len();
                 let nudge = |f: &mut DynamicField, h: f32| {
                     if k < n {
@@ -277,7 +280,7 @@ mod tests {
                 }
                 checked += 1;
                 let numeric = (loss(&a) - loss(&b)) / 2e-2;
-                let analytic = f64::from(grads[layer][k]);
+                let analytic = f64::from(grad[k]);
                 assert!(
                     (numeric - analytic).abs() < 1e-3 * (1.0 + analytic.abs()),
                     "layer {layer} parameter {k}: {numeric} vs {analytic}"

@@ -66,10 +66,6 @@ impl PoseCode {
         self.components.len()
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.components.is_empty()
-    }
-
     /// γ(θ): θ's whitened coordinates along the components.
     pub fn encode(&self, pose: &[f32]) -> Vec<f32> {
         self.components

@@ -42,7 +42,7 @@ impl RemeshSchedule {
     /// α and δ at step `step` of `steps`, if a remeshing is due after it.
     pub fn due(&self, step: usize, steps: usize) -> Option<(f64, f64)> {
         let last = (self.until * steps as f64) as usize;
-        if self.every == 0 || step == 0 || step % self.every != 0 || step > last {
+        if self.every == 0 || step == 0 || !step.is_multiple_of(self.every) || step > last {
             return None;
         }
         let t = step as f64 / last.max(1) as f64;

@@ -15,7 +15,7 @@ pub struct Target {
     pub frame: usize,
     /// Per pixel, the share of its samples labelled as the garment.
     pub mask: Vec<f64>,
-    /// Whether the pixel counts (not a hand).
+    /// Whether the pixel counts (not a hand, nor a garment worn over this one).
     pub counts: Vec<bool>,
     /// Per pixel, the normal in the camera's axes (zero on the background), if the dataset has
     /// normal maps.
@@ -24,8 +24,15 @@ pub struct Target {
 
 impl Target {
     /// Frame `frame` of the dataset at `root`, at the resolution of `camera` (the label map's size
-    /// divided by a whole factor).
-    pub fn read(root: &Path, camera: &Camera, frame: usize, label: u8) -> Result<Self, GarmentError> {
+    /// divided by a whole factor). Pixels of the labels `outer` (garments worn over this one,
+    /// which may hide it) do not count, as hands do not.
+    pub fn read(
+        root: &Path,
+        camera: &Camera,
+        frame: usize,
+        label: u8,
+        outer: &[u8],
+    ) -> Result<Self, GarmentError> {
         let path = layout::label(root, frame);
         let labels = LabelMap::read_png(&path)?;
         let factor = labels.width / camera.width.max(1);
@@ -50,7 +57,8 @@ impl Target {
                     for dx in 0..factor {
                         let i = (y * factor + dy) * labels.width + x * factor + dx;
                         share += f64::from(u8::from(labels.labels[i] == label));
-                        hand |= hands.as_ref().is_some_and(|m| m.values.get(i).copied().unwrap_or(false));
+                        hand |= hands.as_ref().is_some_and(|m| m.values.get(i).copied().unwrap_or(false))
+                            || outer.contains(&labels.labels[i]);
                     }
                 }
                 mask[y * w + x] = share / (factor * factor) as f64;
