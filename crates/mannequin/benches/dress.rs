@@ -6,22 +6,13 @@
 //! `cargo bench -p mannequin --bench dress [-- --seconds 4]`
 
 use std::path::Path;
-use std::process::Command;
-use std::time::Instant;
+
+#[path = "../../../tools/bench_cli.rs"]
+mod bench_cli;
+use bench_cli::mannequin;
 
 /// The target for the whole job, seconds.
 const TARGET_S: f64 = 20.0;
-
-fn mannequin(args: &[&str], cache: &Path) -> f64 {
-    let start = Instant::now();
-    let out = Command::new(env!("CARGO_BIN_EXE_mannequin"))
-        .args(args)
-        .env("XDG_CACHE_HOME", cache)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "mannequin {args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    start.elapsed().as_secs_f64()
-}
 
 fn stages(dir: &Path) -> String {
     let metrics: serde_json::Value =

@@ -10,13 +10,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use mannequin_body::{skeletal_animation, skinned_body};
 use mannequin_data::metrics::geometry::{GeometryMetrics, geometry_metrics};
 use mannequin_data::{Dataset, Split, layout};
 use mannequin_garment::ngd::{
     DynamicSettings, FramePose, Reconstruction, RemeshSchedule, Settings, Target, TrainingFrame,
 };
 use mannequin_garment::{Category, Dressed};
-use mannequin_mesh::TriMesh;
+use mannequin_mesh::{MorphSequence, PointCache, TriMesh, write_scene_glb};
 
 use crate::body::load_body;
 use crate::dress::load_or_make;
@@ -55,8 +56,9 @@ pub struct FitArgs {
     /// Adam's step size on the static Jacobian field.
     #[arg(long, default_value_t = 0.01)]
     rate: f64,
-    /// The Jacobian regulariser's weight (toward the base shape).
-    #[arg(long, default_value_t = 1e-4)]
+    /// The Jacobian regulariser's weight λ in λ Σ ‖M_t − I‖² (toward the base shape); 0 by
+    /// default, since 1e-4 made every garment but the pants worse (docs/ngd.md).
+    #[arg(long, default_value_t = 0.0)]
     regulariser: f64,
     /// NGD's vertex noise (Eqs. 11–12): each step's posed vertices move by γ N(0, 1) (1 − e/T)
     /// at step e of T, so early steps see the garment's overall shape; γ in metres (0: none).
@@ -66,6 +68,11 @@ pub struct FitArgs {
     /// 0 fits the masks alone. Without it: 2 where the dataset has normal maps, else 0.
     #[arg(long)]
     normal_weight: Option<f64>,
+    /// The weight of 1 − SSIM between the rendered and the dataset's normal maps on the
+    /// garment's pixels (with the normal loss); 0 by default, since it made the fit worse
+    /// (docs/ngd.md).
+    #[arg(long, default_value_t = 0.0)]
+    ssim_weight: f64,
     /// NGD's dynamic field (§3.1): an MLP on the pose's first principal components adds a
     /// pose-dependent part to the Jacobians; 0 components: the static field alone.
     #[arg(long, default_value_t = 4)]
@@ -140,6 +147,7 @@ pub fn fit(args: FitArgs) -> Result<()> {
         regulariser: args.regulariser,
         noise: args.noise,
         normal_weight,
+        ssim_weight: if normal_weight > 0.0 { args.ssim_weight } else { 0.0 },
         dynamic: (args.pose_components > 0)
             .then_some(DynamicSettings { components: args.pose_components, rate: args.network_rate }),
         remesh: (args.remesh_every > 0)
@@ -199,6 +207,7 @@ pub fn fit(args: FitArgs) -> Result<()> {
     let path = args.out.join("fit.json");
     mannequin_io::write_atomic(&path, serde_json::to_string_pretty(&report)?.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
+    write_scene(&args.out, &model, &train, &frames, &fit, &args.category)?;
     let geometry = match (&geometry_before, &geometry_after) {
         (Some(b), Some(a)) => format!(
             "; against the ground truth on training frames, Chamfer {:.2} → {:.2} cm, normal consistency {:.3} → {:.3}",
@@ -214,6 +223,36 @@ pub fn fit(args: FitArgs) -> Result<()> {
         mean(&after),
         args.out.display()
     );
+    Ok(())
+}
+
+/// The capture's frame rate as the scene plays it (the datasets do not record one).
+const SCENE_FPS: f32 = 30.0;
+
+/// `fitted.glb`: the skinned body playing the training frames' poses, with the fitted garment in
+/// each (its dynamic field's shape for that pose, skinned) as morph targets in sync; and
+/// `<category>.pc2`, the same frames as a Blender point cache. `mannequin view OUT` plays both.
+fn write_scene(
+    dir: &Path,
+    model: &mannequin_body::BodyModel,
+    train: &Split,
+    frames: &[TrainingFrame],
+    fit: &Reconstruction,
+    category: &str,
+) -> Result<()> {
+    let posed: Vec<Vec<[f32; 3]>> =
+        frames.iter().map(|f| Ok(fit.posed(&f.pose)?.positions)).collect::<Result<_>>()?;
+    PointCache { start: 0.0, sampling: 1.0, frames: posed.clone() }
+        .write(&dir.join(format!("{category}.pc2")))?;
+    let mut mesh = TriMesh::new(posed[0].clone(), fit.faces().to_vec());
+    let colour = Category::named(category).map(|c| c.colour()).unwrap_or([0.6; 3]);
+    mesh.colors = Some(vec![colour; mesh.vertex_count()]);
+    let morphs = [MorphSequence { name: category.to_string(), mesh, frames: posed, fps: SCENE_FPS }];
+    let poses: Vec<f32> = frames.iter().flat_map(|f| f.pose.pose.clone()).collect();
+    let trans: Vec<f32> = frames.iter().flat_map(|f| f.pose.transl).collect();
+    let animation = skeletal_animation(model.num_joints(), &poses, &trans, SCENE_FPS)?;
+    let body = skinned_body(model, &train.poses.betas)?;
+    write_scene_glb(dir.join("fitted.glb"), &body, Some(&animation), &morphs)?;
     Ok(())
 }
 

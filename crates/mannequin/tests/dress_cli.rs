@@ -237,6 +237,15 @@ fn garment_fit_brings_the_template_closer_to_the_label_maps() {
     assert!(fitted > base, "remeshing added no faces: {base} → {fitted}");
     mannequin_mesh::manifold::check_manifold(&mesh.positions, &mesh.faces).unwrap();
     assert_eq!(mannequin_mesh::adjacency::boundary_loops(&mesh.faces).len(), 4);
+    // The scene of the training frames: a point cache of the fitted garment per training frame,
+    // and the glTF beside it, valid.
+    let cache = mannequin_mesh::PointCache::read(&out.join("tshirt.pc2")).unwrap();
+    assert_eq!(cache.frames.len(), 8);
+    assert!(cache.frames.iter().all(|f| f.len() == mesh.vertex_count()));
+    assert!(cache.frames[0] != cache.frames[7], "the garment moves with the body");
+    if let Some(report) = KHRONOS_VALIDATOR.run(&out.join("fitted.glb")) {
+        assert!(report.contains(" 0 errors, 0 warnings"), "{report}");
+    }
     // Pants fitted to the T-shirt's label maps: warned about after the first pass, not silent.
     let mismatch = mannequin(&[
         "garment",

@@ -9,7 +9,7 @@ mod remesh;
 mod scene;
 mod target;
 
-pub use loss::{LossParts, image_loss};
+pub use loss::{LossParts, LossWeights, image_loss};
 pub use reconstruction::{Breakdown, DynamicSettings, Reconstruction, Settings, StepReport, TrainingFrame};
 pub use remesh::RemeshSchedule;
 pub use scene::{CHANNELS, FramePose};

@@ -11,7 +11,7 @@ use mannequin_mesh::manifold::check_manifold;
 use serde::Serialize;
 
 use super::dynamic_field::DynamicField;
-use super::loss::{LossParts, image_loss};
+use super::loss::{LossParts, LossWeights, image_loss};
 use super::pose_code::PoseCode;
 use super::remesh::{RemeshSchedule, remesh_and_carry, selected_edges};
 use super::scene::{FramePose, Scene};
@@ -31,8 +31,9 @@ pub struct Settings {
     pub regulariser: f64,
     /// γ of the vertex noise (Eqs. 11–12), metres (0: none).
     pub noise: f64,
-    /// The normal loss's weight against the mask loss (0: masks only).
+    /// The normal loss's weights against the mask loss: Huber and 1 − SSIM (0, 0: masks only).
     pub normal_weight: f64,
+    pub ssim_weight: f64,
     /// The dynamic field J^D (§3.1): the pose code's length and Adam's rate on the network; None
     /// for the static field alone.
     pub dynamic: Option<DynamicSettings>,
@@ -216,7 +217,8 @@ impl<'a> Reconstruction<'a> {
         let t2 = Breakdown::add(&mut self.breakdown.skinning, t1);
         let rendered = scene.render(&frame.camera);
         let t3 = Breakdown::add(&mut self.breakdown.rasterise, t2);
-        let (parts, grad) = image_loss(&rendered.image, &frame.target, self.settings.normal_weight);
+        let weights = LossWeights { normal: self.settings.normal_weight, ssim: self.settings.ssim_weight };
+        let (parts, grad) = image_loss(&rendered.image, frame.camera.width, &frame.target, weights);
         let t4 = Breakdown::add(&mut self.breakdown.losses, t3);
         let d_rest = scene.backward(&rendered, &grad, &frame.camera);
         let d_field = self.field.step(&d_rest, self.settings.rate, self.settings.regulariser);
