@@ -459,21 +459,39 @@ fn write_scene(
     layers: &[Vec<Vec<[f32; 3]>>],
 ) -> Result<()> {
     let f = motion.num_frames();
-    let mut morphs = Vec::new();
-    for (w, frames) in worn.iter().zip(layers) {
-        PointCache { start: 0.0, sampling: 1.0, frames: frames.clone() }
-            .write(&dir.join(format!("{}.pc2", w.name)))?;
-        let mut mesh = w.garment.mesh.clone();
-        mesh.positions = frames[0].clone();
-        mesh.colors = Some(vec![w.garment.recipe.category.colour(); mesh.vertex_count()]);
-        morphs.push(MorphSequence { name: w.name.clone(), mesh, frames: frames.clone(), fps: motion.fps });
-    }
-    let skinned = skinned_body(model, betas)?;
+    let morphs: Vec<MorphSequence> = worn
+        .iter()
+        .zip(layers)
+        .map(|(w, frames)| {
+            let mut mesh = w.garment.mesh.clone();
+            mesh.positions = frames[0].clone();
+            mesh.colors = Some(vec![w.garment.recipe.category.colour(); mesh.vertex_count()]);
+            MorphSequence { name: w.name.clone(), mesh, frames: frames.clone(), fps: motion.fps }
+        })
+        .collect();
     let poses = motion.poses_for(model)?;
     let pl = model.pose_len();
-    let animation =
-        skeletal_animation(model.num_joints(), &poses[..f * pl], &motion.trans[..3 * f], motion.fps)?;
-    write_scene_glb(dir.join("dressed.glb"), &skinned, Some(&animation), &morphs)?;
+    let motion = (&poses[..f * pl], &motion.trans[..3 * f], motion.fps);
+    write_layered_scene(&dir.join("dressed.glb"), model, betas, motion, &morphs)
+}
+
+/// `glb`: the skinned body of shape `betas` playing `(poses, trans, fps)` (SMPL's layout), with
+/// each layer's frames as morph targets in sync; and beside it each layer's frames as a Blender
+/// point cache, `<name>.pc2`.
+pub(crate) fn write_layered_scene(
+    glb: &Path,
+    model: &BodyModel,
+    betas: &[f32],
+    (poses, trans, fps): (&[f32], &[f32], f32),
+    layers: &[MorphSequence],
+) -> Result<()> {
+    let dir = glb.parent().unwrap_or(Path::new("."));
+    for layer in layers {
+        PointCache { start: 0.0, sampling: 1.0, frames: layer.frames.clone() }
+            .write(&dir.join(format!("{}.pc2", layer.name)))?;
+    }
+    let animation = skeletal_animation(model.num_joints(), poses, trans, fps)?;
+    write_scene_glb(glb, &skinned_body(model, betas)?, Some(&animation), layers)?;
     Ok(())
 }
 

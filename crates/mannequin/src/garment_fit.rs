@@ -10,17 +10,16 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use mannequin_body::{skeletal_animation, skinned_body};
 use mannequin_data::metrics::geometry::{GeometryMetrics, geometry_metrics};
 use mannequin_data::{Dataset, Split, layout};
 use mannequin_garment::ngd::{
     DynamicSettings, FramePose, Reconstruction, RemeshSchedule, Settings, Target, TrainingFrame,
 };
 use mannequin_garment::{Category, Dressed};
-use mannequin_mesh::{MorphSequence, PointCache, TriMesh, write_scene_glb};
+use mannequin_mesh::{MorphSequence, TriMesh};
 
 use crate::body::load_body;
-use crate::dress::load_or_make;
+use crate::dress::{load_or_make, write_layered_scene};
 use crate::progress::{JobTimer, bar};
 
 /// Below this mean mask IoU over the first pass through the frames, the category is probably not
@@ -242,18 +241,18 @@ fn write_scene(
 ) -> Result<()> {
     let posed: Vec<Vec<[f32; 3]>> =
         frames.iter().map(|f| Ok(fit.posed(&f.pose)?.positions)).collect::<Result<_>>()?;
-    PointCache { start: 0.0, sampling: 1.0, frames: posed.clone() }
-        .write(&dir.join(format!("{category}.pc2")))?;
     let mut mesh = TriMesh::new(posed[0].clone(), fit.faces().to_vec());
-    let colour = Category::named(category).map(|c| c.colour()).unwrap_or([0.6; 3]);
-    mesh.colors = Some(vec![colour; mesh.vertex_count()]);
-    let morphs = [MorphSequence { name: category.to_string(), mesh, frames: posed, fps: SCENE_FPS }];
+    mesh.colors = Some(vec![Category::named(category)?.colour(); mesh.vertex_count()]);
+    let layer = MorphSequence { name: category.to_string(), mesh, frames: posed, fps: SCENE_FPS };
     let poses: Vec<f32> = frames.iter().flat_map(|f| f.pose.pose.clone()).collect();
     let trans: Vec<f32> = frames.iter().flat_map(|f| f.pose.transl).collect();
-    let animation = skeletal_animation(model.num_joints(), &poses, &trans, SCENE_FPS)?;
-    let body = skinned_body(model, &train.poses.betas)?;
-    write_scene_glb(dir.join("fitted.glb"), &body, Some(&animation), &morphs)?;
-    Ok(())
+    write_layered_scene(
+        &dir.join("fitted.glb"),
+        model,
+        &train.poses.betas,
+        (&poses, &trans, SCENE_FPS),
+        &[layer],
+    )
 }
 
 fn mean(v: &[f64]) -> f64 {
