@@ -9,6 +9,7 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;
 
 use crate::error::AvatarError;
+use crate::garment_layer::BODY;
 use crate::skirt_layer::{SkirtLayer, SkirtMode, fit_skirt};
 use crate::views::View;
 
@@ -27,6 +28,10 @@ pub struct Canonical {
     /// Per vertex, how much of the offset field applies: 0 where a garment layer hides the body
     /// ([`crate::skirt_layer`]), 1 elsewhere.
     pub offset_gate: Vec<f32>,
+    /// Per vertex, the index of its layer in `layer_names`: 0, the body, or a garment
+    /// ([`crate::garment_layer`]).
+    pub layer: Vec<u8>,
+    pub layer_names: Vec<String>,
 }
 
 impl Canonical {
@@ -41,6 +46,8 @@ impl Canonical {
             parents: model.parents().to_vec(),
             posedirs: model.posedirs().to_vec(),
             offset_gate: vec![1.0; model.num_vertices()],
+            layer: vec![0; model.num_vertices()],
+            layer_names: vec![BODY.to_string()],
         };
         for _ in 0..subdivisions {
             c = c.subdivided();
@@ -60,7 +67,7 @@ impl Canonical {
         let body = Self::from_body(model, betas, 0)?;
         let layer = fit_skirt(&body, views, mode)?;
         let mut c = match &layer {
-            Some(l) => body.with_layer(l),
+            Some(l) => body.with_layer(l)?,
             None => body,
         };
         for _ in 0..subdivisions {
@@ -90,7 +97,11 @@ impl Canonical {
             self.posedirs.chunks_exact(3 * v).flat_map(|row| s.interpolate(row, 3)).collect()
         };
         let weights = s.interpolate(&self.weights, self.num_joints());
+        // An edge never joins two layers, so its midpoint's layer is its ends' layer exactly.
+        let layer = s.interpolate(&self.layer.iter().map(|&l| f32::from(l)).collect::<Vec<_>>(), 1);
         Self {
+            layer: layer.into_iter().map(|l| l.round() as u8).collect(),
+            layer_names: self.layer_names.clone(),
             vertices,
             offset_gate: s.interpolate(&self.offset_gate, 1),
             faces: s.faces,
@@ -120,6 +131,8 @@ impl Canonical {
         let rows = if self.posedirs.is_empty() { 0 } else { self.posedirs.len() / (3 * v) };
         w.add("posedirs", NpyArray::f32(vec![rows, 3 * v], self.posedirs.clone()));
         w.add("offset_gate", NpyArray::f32(vec![v], self.offset_gate.clone()));
+        w.add("layer", NpyArray::i64(vec![v], self.layer.iter().map(|&l| i64::from(l)).collect()));
+        w.add("layer_names", NpyArray::text(&self.layer_names.join("\n")));
     }
 
     /// Reads what [`Canonical::write`] wrote, checking every shape against the vertex and joint
@@ -141,6 +154,17 @@ impl Canonical {
         let offset_gate =
             if npz.contains("offset_gate") { f32s("offset_gate", &[Some(v)])?.1 } else { vec![1.0; v] };
         let bad = |field: &str, reason: String| AvatarError::file(path, format!("{field}: {reason}"));
+        // Models saved before garment layers are all body.
+        let (layer, layer_names) = if npz.contains("layer") {
+            let names: Vec<String> = npz.text("layer_names")?.split('\n').map(String::from).collect();
+            let (_, layer) = npz.f64_with_shape("layer", &[Some(v)])?;
+            if let Some(l) = layer.iter().find(|&&l| l < 0.0 || l as usize >= names.len()) {
+                return Err(bad("layer", format!("layer {l} of {} named in layer_names", names.len())));
+            }
+            (layer.into_iter().map(|l| l as u8).collect(), names)
+        } else {
+            (vec![0; v], vec![BODY.to_string()])
+        };
         let faces: Vec<[u32; 3]> = faces
             .chunks_exact(3)
             .enumerate()
@@ -170,6 +194,8 @@ impl Canonical {
             parents,
             posedirs,
             offset_gate,
+            layer,
+            layer_names,
         })
     }
 }

@@ -362,6 +362,8 @@ mod tests {
             parents: vec![None],
             posedirs: Vec::new(),
             offset_gate: vec![1.0; 4],
+            layer: vec![0; 4],
+            layer_names: vec![crate::garment_layer::BODY.into()],
         }
     }
 

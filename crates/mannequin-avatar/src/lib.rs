@@ -14,6 +14,7 @@ pub mod export;
 pub mod field;
 pub mod fused_binding;
 pub mod fused_mlp;
+pub mod garment_layer;
 pub mod hash_grid;
 pub mod host_ops;
 pub mod ihuman;

@@ -20,6 +20,7 @@ use mannequin_mesh::ring_tube::RingLayout;
 
 use crate::canonical::Canonical;
 use crate::error::AvatarError;
+use crate::garment_layer::GarmentLayer;
 use crate::views::View;
 
 /// Radial step of the carving search (m): about a pixel at 540×540 on a standing subject.
@@ -350,25 +351,16 @@ impl Canonical {
     /// (see [`SkirtLayer::offset_gate`]): no view constrains the body under it, and seen through
     /// the gaps between the layer's Gaussians it would otherwise inflate into the skirt and poke
     /// through (synthetic dress: thighs moved 8 cm on average).
-    pub fn with_layer(mut self, layer: &SkirtLayer) -> Self {
-        let (v, j) = (self.num_vertices(), self.num_joints());
-        let added = layer.skirt.positions.len();
+    pub fn with_layer(self, layer: &SkirtLayer) -> Result<Self, AvatarError> {
         let centre = Vec3::from(self.joints[PELVIS]);
-        for (gate, p) in self.offset_gate.iter_mut().zip(&self.vertices) {
-            *gate = gate.min(layer.offset_gate(Vec3::from(*p), centre));
-        }
-        self.offset_gate.extend(std::iter::repeat_n(1.0, added));
-        if !self.posedirs.is_empty() {
-            self.posedirs = self
-                .posedirs
-                .chunks_exact(3 * v)
-                .flat_map(|row| row.iter().copied().chain(std::iter::repeat_n(0.0, 3 * added)))
-                .collect();
-        }
-        self.vertices.extend_from_slice(&layer.skirt.positions);
-        self.faces.extend(layer.skirt.faces.iter().map(|f| f.map(|i| i + v as u32)));
-        debug_assert_eq!(layer.skirt.weights.len(), added * j);
-        self.weights.extend_from_slice(&layer.skirt.weights);
-        self
+        let gate: Vec<f32> =
+            self.vertices.iter().map(|p| layer.offset_gate(Vec3::from(*p), centre)).collect();
+        let garment = GarmentLayer {
+            name: "skirt".into(),
+            positions: layer.skirt.positions.clone(),
+            faces: layer.skirt.faces.clone(),
+            weights: layer.skirt.weights.clone(),
+        };
+        self.with_garment(&garment, &gate)
     }
 }

@@ -57,7 +57,7 @@ fn a_dress_gets_a_layer_on_the_ground_truth_skirt() {
     // Posed by the avatar (zero offsets at initialisation) into a training frame, the layer's
     // vertices lie on the ground-truth clothed mesh.
     let skirt_vertices = layer.skirt.positions.len();
-    let canonical = body.clone().with_layer(&layer);
+    let canonical = body.clone().with_layer(&layer).unwrap();
 
     // The body under the layer keeps the template: the thighs are gated, the legs just below the
     // hem are mostly gated, and nothing above the waist or a hand below the hem is.
