@@ -156,7 +156,8 @@ fn main() {
         let mut views = load_views(&dataset, &split, |_, _| {}).expect("views");
         perturb_poses(&mut views, arg("--pose-noise", 0.0), subject);
         let (canonical, skirt) =
-            Canonical::for_subject(&model, &split.poses.betas, 0, &views, skirt_mode).expect("canonical");
+            Canonical::for_subject(&model, &split.poses.betas, 0, &views, skirt_mode, &[])
+                .expect("canonical");
         if let Some(layer) = &skirt {
             println!("  skirt: {layer}");
         }

@@ -9,7 +9,7 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;
 
 use crate::error::AvatarError;
-use crate::garment_layer::BODY;
+use crate::garment_layer::{BODY, GarmentLayer};
 use crate::skirt_layer::{SkirtLayer, SkirtMode, fit_skirt};
 use crate::views::View;
 
@@ -56,13 +56,15 @@ impl Canonical {
     }
 
     /// The subject's mesh: the shaped body, plus a skirt layer where `mode` and the views' masks
-    /// call for one (returned too, for reporting), then subdivided.
+    /// call for one (returned too, for reporting), plus `garments` as layers of their own, then
+    /// subdivided.
     pub fn for_subject(
         model: &BodyModel,
         betas: &[f32],
         subdivisions: usize,
         views: &[View],
         mode: SkirtMode,
+        garments: &[GarmentLayer],
     ) -> Result<(Self, Option<SkirtLayer>), AvatarError> {
         let body = Self::from_body(model, betas, 0)?;
         let layer = fit_skirt(&body, views, mode)?;
@@ -70,6 +72,10 @@ impl Canonical {
             Some(l) => body.with_layer(l)?,
             None => body,
         };
+        for garment in garments {
+            let gate = garment.offset_gate(&c.vertices);
+            c = c.with_garment(garment, &gate)?;
+        }
         for _ in 0..subdivisions {
             c = c.subdivided();
         }

@@ -4,12 +4,13 @@
 
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::gltf::influences::top_four;
-use mannequin_mesh::gltf::{Skeleton, SkinnedMesh};
+use mannequin_mesh::gltf::{Skeleton, SkinnedLayer, SkinnedMesh};
 use mannequin_splat::{SplatScene, sh};
 
 use crate::avatar::{Avatar, Posed};
 use crate::config::Method;
 use crate::error::AvatarError;
+use crate::garment_layer::BODY;
 use crate::mesh_gaussians::GaussianGeometry;
 use crate::params::{host, host_rows};
 
@@ -284,6 +285,32 @@ pub fn skinned_mesh(avatar: &Avatar, posed: &Posed) -> Result<SkinnedMesh, Avata
         },
         weights: avatar.canonical.weights.clone(),
     })
+}
+
+/// [`skinned_mesh`] taken apart: the body, and each garment layer as a mesh of its own skinned
+/// by the body's skeleton.
+pub fn skinned_layers(
+    avatar: &Avatar,
+    posed: &Posed,
+) -> Result<(SkinnedMesh, Vec<SkinnedLayer>), AvatarError> {
+    let whole = skinned_mesh(avatar, posed)?;
+    let canonical = &avatar.canonical;
+    let j = canonical.num_joints();
+    let part = |name: &str| -> (TriMesh, Vec<f32>) {
+        let (kept, _) = canonical.layer_part(name).expect("a layer the canonical mesh names");
+        let mesh = canonical.layer_mesh(name, &whole.mesh).expect("a layer the canonical mesh names");
+        (mesh, kept.iter().flat_map(|&v| whole.weights[v * j..(v + 1) * j].iter().copied()).collect())
+    };
+    let layers = canonical
+        .garment_names()
+        .iter()
+        .map(|name| {
+            let (mesh, weights) = part(name);
+            SkinnedLayer { name: name.clone(), mesh, weights }
+        })
+        .collect();
+    let (mesh, weights) = part(BODY);
+    Ok((SkinnedMesh { mesh, weights, skeleton: whole.skeleton }, layers))
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 //! index of the layer it belongs to, so exports and evaluation can take the layers apart again.
 
 use glam::Vec3;
+use mannequin_mesh::TriMesh;
 use mannequin_mesh::adjacency::boundary_loops;
 use mannequin_mesh::closest_point::ClosestPoint;
 
@@ -98,15 +99,15 @@ impl Canonical {
         &self.layer_names[1..]
     }
 
-    /// The faces of layer `name`, indexing `positions` (the mesh's vertices in any pose), as a
-    /// mesh of its own: only its vertices, renumbered. `None` when there is no such layer.
-    pub fn layer_mesh(&self, name: &str, positions: &[[f32; 3]]) -> Option<(Vec<[f32; 3]>, Vec<[u32; 3]>)> {
+    /// Layer `name` as a mesh of its own: the mesh's vertices it keeps, in order, and its faces
+    /// renumbered to index them. `None` when there is no such layer.
+    pub fn layer_part(&self, name: &str) -> Option<(Vec<usize>, Vec<[u32; 3]>)> {
         let index = self.layer_names.iter().position(|n| n == name)? as u8;
         let mut renumbered = vec![u32::MAX; self.num_vertices()];
         let mut kept = Vec::new();
         for i in (0..self.num_vertices()).filter(|&i| self.layer[i] == index) {
             renumbered[i] = kept.len() as u32;
-            kept.push(positions[i]);
+            kept.push(i);
         }
         let faces = self
             .faces
@@ -115,6 +116,14 @@ impl Canonical {
             .map(|f| f.map(|i| renumbered[i as usize]))
             .collect();
         Some((kept, faces))
+    }
+
+    /// Layer `name`'s part of `mesh` (this mesh's faces, in any pose, with any colours).
+    pub fn layer_mesh(&self, name: &str, mesh: &TriMesh) -> Option<TriMesh> {
+        let (kept, faces) = self.layer_part(name)?;
+        let mut part = TriMesh::new(kept.iter().map(|&i| mesh.positions[i]).collect(), faces);
+        part.colors = mesh.colors.as_ref().map(|c| kept.iter().map(|&i| c[i]).collect());
+        Some(part)
     }
 }
 
@@ -180,12 +189,16 @@ mod tests {
         assert_eq!(body.garment_names(), ["dress"]);
         assert_eq!(body.offset_gate[3], 0.0);
         assert_eq!(body.offset_gate.iter().filter(|&&g| g == 0.0).count(), 1);
-        assert_eq!(body.layer_mesh("dress", &body.vertices), Some((positions, faces)));
-        assert_eq!(body.layer_mesh(BODY, &body.vertices), Some((body_positions, body_faces)));
+        let whole = TriMesh::new(body.vertices.clone(), body.faces.clone());
+        assert_eq!(body.layer_mesh("dress", &whole), Some(TriMesh::new(positions, faces)));
+        assert_eq!(body.layer_mesh(BODY, &whole), Some(TriMesh::new(body_positions, body_faces)));
+        assert_eq!(body.layer_mesh("cape", &whole), None);
         // Subdivision keeps every new vertex in its edge's layer (24 + 24 ring, 18 vertical and
         // 18 diagonal edges' midpoints).
         let fine = body.subdivided();
-        let (p, f) = fine.layer_mesh("dress", &fine.vertices).unwrap();
+        let part =
+            fine.layer_mesh("dress", &TriMesh::new(fine.vertices.clone(), fine.faces.clone())).unwrap();
+        let (p, f) = (part.positions, part.faces);
         assert_eq!((p.len(), f.len()), (24 + 60, 4 * 36));
         assert!(p.iter().all(|q| ((q[0] * q[0] + q[2] * q[2]).sqrt() - 0.3).abs() < 0.05));
         // Weights of the wrong length are refused, naming the layer.

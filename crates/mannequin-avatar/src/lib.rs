@@ -34,7 +34,7 @@ pub use canonical::Canonical;
 pub use config::{AVATAR_DILATION, AvatarConfig, Method};
 pub use error::AvatarError;
 pub use predict::{Prediction, predict, predict_split};
-pub use run::TrainingRun;
+pub use run::{GarmentRecord, TrainingRun};
 pub use skirt_layer::SkirtMode;
 pub use trainer::{HALF_RESOLUTION_SHARE, StepStats, Timings, TrainOptions, Trainer};
 pub use views::{View, frame_camera, load_views};

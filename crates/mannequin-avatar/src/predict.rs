@@ -1,6 +1,7 @@
 //! Inference: render an avatar at a pose through a camera into host images (colour over white,
 //! normal map, mask, depth) and its posed mesh, and write whole test sets in the dataset layout
-//! so `mannequin_data::evaluation` can score them.
+//! (each garment layer's mesh too, as a synthetic subject's ground truth has them) so
+//! `mannequin_data::evaluation` can score them.
 
 use std::path::Path;
 
@@ -83,6 +84,11 @@ pub fn predict_split(
             depth: Some(p.depth),
         })?;
         writer.write_mesh(frame, &p.mesh)?;
+        for name in avatar.canonical.garment_names() {
+            if let Some(part) = avatar.canonical.layer_mesh(name, &p.mesh) {
+                writer.write_garment_mesh(frame, name, &part)?;
+            }
+        }
         on_frame();
     }
     Ok(())

@@ -27,9 +27,20 @@ pub struct TrainingRun {
     pub downscale: usize,
     /// Whether a skirt layer may be added; `avatar.skirt_layer` says whether one was.
     pub skirt: SkirtMode,
+    /// The garments reconstructed as layers of their own (none: no such field, so checkpoints
+    /// from before garment layers still resume).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub garments: Option<GarmentRecord>,
     pub data: Fingerprint,
     pub avatar: AvatarConfig,
     pub options: TrainOptions,
+}
+
+/// The garment layers asked for: their categories and each reconstruction's steps.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GarmentRecord {
+    pub categories: Vec<String>,
+    pub steps: usize,
 }
 
 /// Every leaf of `value` by its dotted path, as text (strings unquoted).
@@ -105,6 +116,7 @@ mod tests {
             body: "default".into(),
             downscale: 2,
             skirt: SkirtMode::Auto,
+            garments: None,
             data: Fingerprint {
                 files: 3,
                 bytes: 1000,

@@ -23,6 +23,8 @@ use crate::error::AvatarError;
 use crate::garment_layer::GarmentLayer;
 use crate::views::View;
 
+/// The layer's name among the canonical mesh's layers.
+pub const LAYER_NAME: &str = "skirt_layer";
 /// Radial step of the carving search (m): about a pixel at 540×540 on a standing subject.
 const STEP: f32 = 0.003;
 /// How far past the body's own outline the hull is searched (m).
@@ -356,7 +358,7 @@ impl Canonical {
         let gate: Vec<f32> =
             self.vertices.iter().map(|p| layer.offset_gate(Vec3::from(*p), centre)).collect();
         let garment = GarmentLayer {
-            name: "skirt".into(),
+            name: LAYER_NAME.into(),
             positions: layer.skirt.positions.clone(),
             faces: layer.skirt.faces.clone(),
             weights: layer.skirt.weights.clone(),

@@ -52,6 +52,7 @@ fn record(t: &Trainer, data: &Path) -> TrainingRun {
         body: "default-lod1".into(),
         downscale: 1,
         skirt: SkirtMode::Off,
+        garments: None,
         data: Fingerprint::of(&dataset, &split).unwrap(),
         avatar: t.avatar.config.clone(),
         options: t.options.clone(),

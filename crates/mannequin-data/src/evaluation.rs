@@ -5,9 +5,11 @@
 //! earlier run, say) are never scored. Each folder's images may be PNG or JPEG
 //! (`images/image_NNNN.png` or `.jpg`). The ground truth is composited on the stated background
 //! with its mask; the prediction is taken as rendered. Where both folders hold normal maps (`normals/`) or meshes (`meshes/`), normal and
-//! geometry metrics are added. A ground truth at an integer multiple of the prediction's size
+//! geometry metrics are added, and
+//! per garment where both hold its meshes (`meshes/garment_<name>_%04d.ply`). A ground truth at an integer multiple of the prediction's size
 //! is box-downscaled to it first (PeopleSnapshot's 1080² against 540² renders).
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -43,6 +45,8 @@ pub struct FrameScores {
     pub chamfer_cm: Option<f64>,
     pub p2s_cm: Option<f64>,
     pub normal_consistency: Option<f64>,
+    /// Per garment that both folders have meshes of (`meshes/garment_<name>_%04d.ply`).
+    pub garments: BTreeMap<String, GeometryMetrics>,
 }
 
 /// Means over frames (over the frames that have the metric, for the optional ones).
@@ -61,7 +65,50 @@ pub struct EvalSummary {
     pub chamfer_cm: Option<f64>,
     pub p2s_cm: Option<f64>,
     pub normal_consistency: Option<f64>,
+    /// Per garment, over the frames that have it.
+    pub garments: BTreeMap<String, GeometryMetrics>,
     pub per_frame: Vec<FrameScores>,
+}
+
+/// The mean of each garment's metrics over the frames that have it.
+pub(crate) fn garment_means(frames: &[FrameScores]) -> BTreeMap<String, GeometryMetrics> {
+    let mut sums: BTreeMap<String, (GeometryMetrics, usize)> = BTreeMap::new();
+    for (name, m) in frames.iter().flat_map(|f| &f.garments) {
+        let zero = GeometryMetrics { chamfer_cm: 0.0, p2s_cm: 0.0, normal_consistency: 0.0 };
+        let (sum, n) = sums.entry(name.clone()).or_insert((zero, 0));
+        sum.chamfer_cm += m.chamfer_cm;
+        sum.p2s_cm += m.p2s_cm;
+        sum.normal_consistency += m.normal_consistency;
+        *n += 1;
+    }
+    sums.into_iter()
+        .map(|(name, (s, n))| {
+            let n = n as f64;
+            let mean = GeometryMetrics {
+                chamfer_cm: s.chamfer_cm / n,
+                p2s_cm: s.p2s_cm / n,
+                normal_consistency: s.normal_consistency / n,
+            };
+            (name, mean)
+        })
+        .collect()
+}
+
+/// The names of the garments whose meshes `dir` holds (`meshes/garment_<name>_%04d.ply`).
+fn garment_names(dir: &Path) -> Result<BTreeSet<String>, DataError> {
+    let meshes = dir.join(layout::MESHES);
+    if !meshes.is_dir() {
+        return Ok(BTreeSet::new());
+    }
+    let entries = std::fs::read_dir(&meshes).map_err(|e| DataError::os(&meshes, e))?;
+    Ok(entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter_map(|f| {
+            let stem = f.strip_prefix("garment_")?.strip_suffix(".ply")?;
+            let (name, frame) = stem.rsplit_once('_')?;
+            frame.parse::<usize>().ok().map(|_| name.to_string())
+        })
+        .collect())
 }
 
 /// The frames of `gt`'s test split: what a prediction folder for it is scored on.
@@ -112,6 +159,7 @@ pub(crate) fn mean_of(frames: &[FrameScores], get: impl Fn(&FrameScores) -> Opti
 fn score_frame(
     (pred, gt): (&Path, &Path),
     images: &(ImageFiles, ImageFiles),
+    garment_names: &BTreeSet<String>,
     frame: usize,
     opt: &EvalOptions,
 ) -> Result<(FrameScores, usize), DataError> {
@@ -146,14 +194,22 @@ fn score_frame(
     } else {
         None
     };
-    let (pm_path, gm_path) = (layout::mesh(pred, frame), layout::mesh(gt, frame));
-    let geometry: Option<GeometryMetrics> = if pm_path.exists() && gm_path.exists() {
+    let mesh_metrics = |pm_path: PathBuf, gm_path: PathBuf| -> Result<Option<GeometryMetrics>, DataError> {
+        if !(pm_path.exists() && gm_path.exists()) {
+            return Ok(None);
+        }
         let pm = mannequin_mesh::ply::read(&pm_path)?.mesh;
         let gm = mannequin_mesh::ply::read(&gm_path)?.mesh;
-        Some(geometry_metrics(&pm, &gm, opt.samples, opt.seed))
-    } else {
-        None
+        Ok(Some(geometry_metrics(&pm, &gm, opt.samples, opt.seed)))
     };
+    let geometry = mesh_metrics(layout::mesh(pred, frame), layout::mesh(gt, frame))?;
+    let mut garments = BTreeMap::new();
+    for name in garment_names {
+        let paths = (layout::garment_mesh(pred, name, frame), layout::garment_mesh(gt, name, frame));
+        if let Some(m) = mesh_metrics(paths.0, paths.1)? {
+            garments.insert(name.clone(), m);
+        }
+    }
     Ok((
         FrameScores {
             frame,
@@ -165,6 +221,7 @@ fn score_frame(
             chamfer_cm: geometry.map(|m| m.chamfer_cm),
             p2s_cm: geometry.map(|m| m.p2s_cm),
             normal_consistency: geometry.map(|m| m.normal_consistency),
+            garments,
         },
         factor,
     ))
@@ -183,10 +240,11 @@ pub fn evaluate(
         return Err(DataError::file(gt, "no test frames to score"));
     }
     let images = (ImageFiles::list(pred)?, ImageFiles::list(gt)?);
+    let garments = garment_names(pred)?;
     let mut per_frame = Vec::with_capacity(frames.len());
     let mut gt_downscale = 1;
     for &f in frames {
-        let (scores, factor) = score_frame((pred, gt), &images, f, opt)?;
+        let (scores, factor) = score_frame((pred, gt), &images, &garments, f, opt)?;
         gt_downscale = factor;
         on_frame(&scores);
         per_frame.push(scores);
@@ -205,6 +263,7 @@ pub fn evaluate(
         chamfer_cm: mean_of(&per_frame, |s| s.chamfer_cm),
         p2s_cm: mean_of(&per_frame, |s| s.p2s_cm),
         normal_consistency: mean_of(&per_frame, |s| s.normal_consistency),
+        garments: garment_means(&per_frame),
         per_frame,
     })
 }

@@ -3,7 +3,10 @@
 
 use serde::Serialize;
 
-use crate::evaluation::{EvalSummary, FrameScores, mean_of};
+use std::collections::BTreeMap;
+
+use crate::evaluation::{EvalSummary, FrameScores, garment_means, mean_of};
+use crate::metrics::geometry::GeometryMetrics;
 
 /// What a test set holds, named for what it tests.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -37,6 +40,8 @@ pub struct GeometryScores {
     pub normal_consistency: Option<f64>,
     pub normal_angle_deg: Option<f64>,
     pub normal_mse_x1e3: Option<f64>,
+    /// Per garment, over every frame with its meshes.
+    pub garments: BTreeMap<String, GeometryMetrics>,
 }
 
 /// Each test set's summary (`None` where the dataset has no such set), and the geometry.
@@ -58,6 +63,7 @@ impl Scores {
             normal_consistency: mean_of(&all, |s| s.normal_consistency),
             normal_angle_deg: mean_of(&all, |s| s.normal_angle_deg),
             normal_mse_x1e3: mean_of(&all, |s| s.normal_mse_x1e3),
+            garments: garment_means(&all),
         };
         let mut scores = Self { novel_view: None, novel_pose: None, test: None, geometry };
         for (set, summary) in sets {

@@ -119,6 +119,12 @@ fn print_scores(s: &Scores) {
         cell(g.normal_angle_deg, 2),
         cell(g.normal_mse_x1e3, 2)
     );
+    for (name, m) in &g.garments {
+        println!(
+            "{name}: Chamfer {:.3} cm, P2S {:.3} cm, normal consistency {:.3}",
+            m.chamfer_cm, m.p2s_cm, m.normal_consistency
+        );
+    }
 }
 
 pub fn run(args: Args) -> Result<()> {

@@ -28,7 +28,8 @@ pub struct Args {
     pose: PoseChoice,
     /// The mesh with vertex colour baked from the Gaussians, by extension: `.obj` or `.ply` at the
     /// pose, or a skinned `.glb` (bind pose: the canonical mesh; COLOR_0; the avatar's skeleton
-    /// and weights; canonical pose only).
+    /// and weights; canonical pose only). Garment layers are nodes of their own in a `.glb`, and
+    /// files of their own beside an `.obj`/`.ply` (`<stem>.<garment>.obj`).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// The Gaussians at the pose as a 3DGS `.ply` in the INRIA layout, for splat viewers.
@@ -63,15 +64,29 @@ fn write_output(
     output: &Path,
 ) -> Result<()> {
     if let Some(motion) = glb {
-        let skinned = export::skinned_mesh(avatar, posed)?;
+        let (body, layers) = export::skinned_layers(avatar, posed)?;
         let animation = motion.map(|m| avatar_animation(avatar, m)).transpose()?;
-        return mannequin_mesh::gltf::write_glb(output, &skinned, animation.as_ref())
+        return mannequin_mesh::gltf::write_layered_glb(output, &body, &layers, animation.as_ref())
             .with_context(|| format!("writing {}", output.display()));
     }
     let vertices = if canonical { &posed.personalised } else { &posed.vertices };
     let mut mesh = TriMesh::new(host_rows(vertices.clone()), avatar.canonical.faces.clone());
     mesh.colors = Some(export::vertex_colours(avatar, posed)?);
-    write_mesh(output, &mesh)
+    write_mesh(output, &mesh)?;
+    for name in avatar.canonical.garment_names() {
+        let part = avatar.canonical.layer_mesh(name, &mesh).expect("a layer the canonical mesh names");
+        let path = layer_path(output, name);
+        write_mesh(&path, &part)?;
+        tracing::info!("wrote {} (the {name} layer)", path.display());
+    }
+    Ok(())
+}
+
+/// Where a layer of `output` goes: `<stem>.<layer>.<extension>` beside it.
+fn layer_path(output: &Path, layer: &str) -> PathBuf {
+    let stem = output.file_stem().map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
+    let extension = output.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
+    output.with_file_name(format!("{stem}.{layer}{extension}"))
 }
 
 /// `motion` as an animation of the avatar's glTF skeleton ([`export::skinned_mesh`]).

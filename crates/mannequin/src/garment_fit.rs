@@ -46,12 +46,25 @@ pub struct FitArgs {
     /// maps, when it is not named after the category (a segmenter's "upper", say).
     #[arg(long)]
     label: Option<String>,
+    /// The body model the dataset's poses are for.
+    #[arg(long, default_value = "default")]
+    body: String,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    ngd: NgdArgs,
+}
+
+/// How a garment is reconstructed; `mannequin train --garments` fits with the defaults.
+#[derive(clap::Args, Clone)]
+pub struct NgdArgs {
     /// The base template's size.
     #[arg(long, default_value = "M")]
     size: String,
     /// Optimisation steps (one training frame each).
     #[arg(long, default_value_t = 400)]
-    iters: usize,
+    pub iters: usize,
     /// Adam's step size on the static Jacobian field.
     #[arg(long, default_value_t = 0.01)]
     rate: f64,
@@ -89,28 +102,55 @@ pub struct FitArgs {
     /// Seeds the order the frames are visited in.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// The body model the dataset's poses are for.
-    #[arg(long, default_value = "default")]
-    body: String,
-    /// Output folder.
-    #[arg(long)]
-    out: PathBuf,
+}
+
+impl NgdArgs {
+    /// The defaults, as `garment fit` has them, with `seed`.
+    pub fn defaults(seed: u64) -> Self {
+        use clap::{Args, FromArgMatches};
+        let matches = Self::augment_args(clap::Command::new("ngd")).get_matches_from(["ngd"]);
+        let mut args = Self::from_arg_matches(&matches).expect("the defaults parse");
+        args.seed = seed;
+        args
+    }
+}
+
+/// A reconstructed garment at rest on the dataset's body, with its skinning weights (V × J).
+pub struct FittedGarment {
+    pub category: String,
+    pub positions: Vec<[f32; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    pub weights: Vec<f32>,
 }
 
 pub fn fit(args: FitArgs) -> Result<()> {
     let _timer = JobTimer::start("garment fit");
+    let label = args.label.as_deref().unwrap_or(&args.category);
+    reconstruct(&args.data, &args.category, label, &args.body, &args.ngd, &args.out)?;
+    Ok(())
+}
+
+/// Reconstructs the garment of `category` that `label` marks in the dataset at `data`, writing
+/// `garment.obj`, `fit.json`, `fitted.glb` and the point cache into `out`.
+pub fn reconstruct(
+    data: &Path,
+    category: &str,
+    label_name: &str,
+    body: &str,
+    ngd: &NgdArgs,
+    out: &Path,
+) -> Result<FittedGarment> {
     let start = Instant::now();
-    let dataset = Dataset::open(&args.data, args.downscale)?;
-    let label_name = args.label.as_deref().unwrap_or(&args.category);
-    let legend = label_legend(&args.data)?;
-    let label = label_index(&args.data, &legend, label_name)?;
-    let outer = outer_labels(&legend, &args.category)?;
-    let model = load_body(&args.body)?;
+    let dataset = Dataset::open(data, ngd.downscale)?;
+    let legend = label_legend(data)?;
+    let label = label_index(data, &legend, label_name)?;
+    let outer = outer_labels(&legend, category)?;
+    let model = load_body(body)?;
     let train = dataset.split("train")?;
     if train.frames.is_empty() {
-        bail!("{}: the train split has no frames", args.data.display());
+        bail!("{}: the train split has no frames", data.display());
     }
-    let (_, garment) = load_or_make(&args.category, &model, &args.body, &args.size)?;
+    let (_, garment) = load_or_make(category, &model, body, &ngd.size)?;
     let dressed = Dressed::new(&garment, &model, &train.poses.betas)?;
     let frames = train
         .frames
@@ -118,15 +158,15 @@ pub fn fit(args: FitArgs) -> Result<()> {
         .enumerate()
         .map(|(k, &f)| {
             let camera = dataset.camera(f).clone();
-            let target = Target::read(&args.data, &camera, f, label, &outer)?;
+            let target = Target::read(data, &camera, f, label, &outer)?;
             Ok(TrainingFrame { target, camera, pose: frame_pose(&train, k) })
         })
         .collect::<Result<Vec<_>>>()?;
     let has_normals = frames.iter().all(|f| f.target.normals.is_some());
-    let normal_weight = match args.normal_weight {
+    let normal_weight = match ngd.normal_weight {
         Some(w) if w > 0.0 && !has_normals => bail!(
             "{}: --normal-weight {w} needs normal maps ({}/normal_%04d.png) for every training frame",
-            args.data.display(),
+            data.display(),
             layout::NORMALS
         ),
         Some(w) => w,
@@ -134,34 +174,34 @@ pub fn fit(args: FitArgs) -> Result<()> {
         None => {
             tracing::info!(
                 "{}: no normal maps for every training frame ({}/normal_%04d.png): fitting the label maps alone",
-                args.data.display(),
+                data.display(),
                 layout::NORMALS
             );
             0.0
         }
     };
     let settings = Settings {
-        steps: args.iters,
-        rate: args.rate,
-        regulariser: args.regulariser,
-        noise: args.noise,
+        steps: ngd.iters,
+        rate: ngd.rate,
+        regulariser: ngd.regulariser,
+        noise: ngd.noise,
         normal_weight,
-        ssim_weight: if normal_weight > 0.0 { args.ssim_weight } else { 0.0 },
-        dynamic: (args.pose_components > 0)
-            .then_some(DynamicSettings { components: args.pose_components, rate: args.network_rate }),
-        remesh: (args.remesh_every > 0)
-            .then(|| RemeshSchedule { every: args.remesh_every, ..Default::default() }),
-        seed: args.seed,
+        ssim_weight: if normal_weight > 0.0 { ngd.ssim_weight } else { 0.0 },
+        dynamic: (ngd.pose_components > 0)
+            .then_some(DynamicSettings { components: ngd.pose_components, rate: ngd.network_rate }),
+        remesh: (ngd.remesh_every > 0)
+            .then(|| RemeshSchedule { every: ngd.remesh_every, ..Default::default() }),
+        seed: ngd.seed,
     };
     let poses: Vec<Vec<f32>> = frames.iter().map(|f| f.pose.pose.clone()).collect();
     let mut fit = Reconstruction::new(&dressed, settings, &poses)?;
-    let evaluation = Evaluation::new(&args.data, &dataset, &args.category)?;
+    let evaluation = Evaluation::new(data, &dataset, category)?;
     let before = fit.mask_iou(&frames)?;
     let geometry_before = evaluation.measure(&fit)?;
-    let progress = bar(args.iters as u64, "garment fit");
-    let mut losses = Vec::with_capacity(args.iters);
+    let progress = bar(ngd.iters as u64, "garment fit");
+    let mut losses = Vec::with_capacity(ngd.iters);
     let mut first_pass = Vec::new();
-    for _ in 0..args.iters {
+    for _ in 0..ngd.iters {
         let report = fit.step(&frames)?;
         losses.push(report.losses);
         if first_pass.len() < frames.len() {
@@ -171,9 +211,9 @@ pub fn fit(args: FitArgs) -> Result<()> {
                     tracing::warn!(
                         "the {} overlaps its label maps by a mean mask IoU of {:.2} over the first pass through the \
                          frames (below {MISMATCH_IOU}): the label '{label_name}' may not mark a garment of category {}",
-                        args.category,
+                        category,
                         mean(&first_pass),
-                        args.category
+                        category
                     )
                 });
             }
@@ -183,13 +223,13 @@ pub fn fit(args: FitArgs) -> Result<()> {
     progress.finish();
     let after = fit.mask_iou(&frames)?;
     let geometry_after = evaluation.measure(&fit)?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     // The template's UVs hold while the topology is the template's.
     let uv = garment.mesh.uv.clone().filter(|_| fit.faces().len() == garment.mesh.faces.len());
     let mesh = TriMesh { positions: fit.rest(), faces: fit.faces().to_vec(), uv, colors: None };
-    crate::body::write_mesh(&args.out.join("garment.obj"), &mesh)?;
+    crate::body::write_mesh(&out.join("garment.obj"), &mesh)?;
     let report = serde_json::json!({
-        "category": args.category,
+        "category": category,
         "label": label_name,
         "settings": fit.settings(),
         "frames": train.frames,
@@ -203,10 +243,10 @@ pub fn fit(args: FitArgs) -> Result<()> {
         "ms_per_step": fit.breakdown.per_step_ms(fit.steps_taken()),
         "seconds": start.elapsed().as_secs_f64(),
     });
-    let path = args.out.join("fit.json");
+    let path = out.join("fit.json");
     mannequin_io::write_atomic(&path, serde_json::to_string_pretty(&report)?.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
-    write_scene(&args.out, &model, &train, &frames, &fit, &args.category)?;
+    write_scene(out, &model, &train, &frames, &fit, category)?;
     let geometry = match (&geometry_before, &geometry_after) {
         (Some(b), Some(a)) => format!(
             "; against the ground truth on training frames, Chamfer {:.2} → {:.2} cm, normal consistency {:.3} → {:.3}",
@@ -216,13 +256,18 @@ pub fn fit(args: FitArgs) -> Result<()> {
     };
     tracing::info!(
         "fitted the {} to {} frames: mask IoU {:.3} → {:.3}{geometry}; wrote {}",
-        args.category,
+        category,
         frames.len(),
         mean(&before),
         mean(&after),
-        args.out.display()
+        out.display()
     );
-    Ok(())
+    Ok(FittedGarment {
+        category: category.to_string(),
+        positions: fit.rest(),
+        faces: fit.faces().to_vec(),
+        weights: fit.weights().to_vec(),
+    })
 }
 
 /// The capture's frame rate as the scene plays it (the datasets do not record one).
@@ -264,7 +309,7 @@ fn frame_pose(split: &Split, k: usize) -> FramePose {
 }
 
 /// The dataset's label names (`subject.json`'s `labels`), by index.
-fn label_legend(root: &Path) -> Result<Vec<String>> {
+pub fn label_legend(root: &Path) -> Result<Vec<String>> {
     let path = root.join("subject.json");
     let text = std::fs::read_to_string(&path).with_context(|| {
         format!("{}: the dataset has no label legend (subject.json with \"labels\"); garment fit needs label maps", path.display())

@@ -16,6 +16,7 @@ mod face_track;
 mod fit;
 mod garment;
 mod garment_fit;
+mod garment_layers;
 mod motion;
 mod pose_choice;
 mod progress;

@@ -5,16 +5,19 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
+use mannequin_avatar::avatar::PARAMS_FILE;
+use mannequin_avatar::skirt_layer;
 use mannequin_avatar::trainer::checkpoint_path;
 use mannequin_avatar::{
-    Avatar, AvatarConfig, AvatarError, Canonical, Method, SkirtMode, TrainOptions, Trainer, TrainingRun,
-    load_views,
+    Avatar, AvatarConfig, AvatarError, Canonical, GarmentRecord, Method, SkirtMode, TrainOptions, Trainer,
+    TrainingRun, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::{Dataset, Fingerprint};
 use mannequin_io::Npz;
 
 use crate::compute::Compute;
+use crate::garment_layers;
 use crate::progress::{JobTimer, bar};
 
 #[derive(ClapArgs, Clone)]
@@ -65,6 +68,15 @@ pub struct Args {
     /// mid-thigh) or off.
     #[arg(long, value_enum, default_value_t = SkirtMode::Auto)]
     pub skirt: SkirtMode,
+    /// Garments worn as layers of their own, each reconstructed from the label maps (as
+    /// `garment fit` does) before the avatar trains over it: `auto` (every garment in the label
+    /// maps' legend) or categories, e.g. `upper:tshirt,lower:pants`. A skirt or dress replaces
+    /// the skirt layer. Fits are written to OUT/garments/<category>/.
+    #[arg(long)]
+    pub garments: Option<String>,
+    /// Steps of each garment's reconstruction (`garment fit --iters`).
+    #[arg(long, default_value_t = 400, requires = "garments")]
+    pub garment_iters: usize,
     /// Where training runs: cpu (Flex) or gpu (wgpu on Vulkan).
     #[arg(long, value_enum, default_value_t = Compute::Cpu)]
     pub device: Compute,
@@ -121,10 +133,20 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
             model.num_joints()
         );
     }
+    let garments = match &args.garments {
+        Some(spec) => garment_layers::resolve(spec, &args.data)?,
+        None => Vec::new(),
+    };
+    // A skirt or dress garment is the skirt layer's better replacement.
+    let skirt = if garments.iter().any(|c| c.flare().is_some()) { SkirtMode::Off } else { args.skirt };
     let mut record = TrainingRun {
         body: args.body.clone(),
         downscale: args.downscale,
-        skirt: args.skirt,
+        skirt,
+        garments: (!garments.is_empty()).then(|| GarmentRecord {
+            categories: garments.iter().map(|c| c.name().to_string()).collect(),
+            steps: args.garment_iters,
+        }),
         data: Fingerprint::of(&dataset, &split)?,
         avatar: avatar_config(args),
         options: train_options(args),
@@ -152,12 +174,26 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
     if views.iter().any(|v| !v.has_normals()) {
         tracing::warn!("{} has no normal maps: the normal loss is off", args.data.display());
     }
-    let (canonical, skirt) =
-        Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, args.skirt)?;
-    if let Some(layer) = &skirt {
-        tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
-    }
-    record.avatar.skirt_layer = skirt.is_some();
+    let saved = args.out.join(PARAMS_FILE);
+    let canonical = if resume && !garments.is_empty() && saved.exists() {
+        // The garments were reconstructed when this run began; the model folder kept them.
+        Canonical::read(&Npz::read(&saved)?, &saved)?
+    } else {
+        let layers = garment_layers::reconstruct_all(
+            &garments,
+            &args.data,
+            &args.body,
+            (args.seed, args.garment_iters),
+            &args.out,
+        )?;
+        let (canonical, skirt_layer) =
+            Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, skirt, &layers)?;
+        if let Some(layer) = &skirt_layer {
+            tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
+        }
+        canonical
+    };
+    record.avatar.skirt_layer = canonical.layer_names.iter().any(|n| n == skirt_layer::LAYER_NAME);
     let device = args.device.device()?.autodiff();
     let avatar = Avatar::new(record.avatar.clone(), canonical, &device)?;
     let mut trainer = Trainer::new(avatar, views, record.options.clone())?;

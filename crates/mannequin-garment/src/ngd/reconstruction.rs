@@ -184,6 +184,11 @@ impl<'a> Reconstruction<'a> {
         &self.faces
     }
 
+    /// The skinning weights of the current vertices, V × J.
+    pub fn weights(&self) -> &[f32] {
+        &self.weights
+    }
+
     /// The regulariser's current value.
     pub fn regulariser(&self) -> f64 {
         self.field.regulariser(self.settings.regulariser)

@@ -17,11 +17,11 @@ use serde_json::{Value, json};
 use super::buffer::{ARRAY_BUFFER, Buffer, ELEMENT_ARRAY_BUFFER, Int};
 use super::glb::glb;
 use super::influences::top_four;
-use super::model::{SkeletalAnimation, SkinnedMesh};
+use super::model::{SkeletalAnimation, SkinnedLayer, SkinnedMesh};
 use super::morph::MorphSequence;
 use super::split::split_uv_seams;
-use crate::MeshFileError;
 use crate::normals::vertex_normals;
+use crate::{MeshFileError, TriMesh};
 
 /// Writes `skinned` (and `animation`, when given, as the file's single animation) to a `.glb`
 /// file atomically. The mesh node sits at the scene root with no transform of its own, as glTF
@@ -47,6 +47,26 @@ pub fn write_scene_glb(
     mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
 }
 
+/// [`write_glb`] with `layers` (garments, say) as skinned meshes of their own, each its own node
+/// driven by the body's skeleton.
+pub fn write_layered_glb(
+    path: impl AsRef<Path>,
+    skinned: &SkinnedMesh,
+    layers: &[SkinnedLayer],
+    animation: Option<&SkeletalAnimation>,
+) -> Result<(), MeshFileError> {
+    let path = path.as_ref();
+    skinned.validate(path)?;
+    if let Some(a) = animation {
+        a.validate(path, skinned.skeleton.joint_count())?;
+    }
+    for l in layers {
+        l.validate(path, skinned.skeleton.joint_count())?;
+    }
+    let bytes = encode(path, skinned, layers, animation, &[])?;
+    mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
+}
+
 /// The bytes [`write_scene_glb`] writes, for a server that sends them instead; `name` names the
 /// file in errors.
 pub fn scene_glb_bytes(
@@ -62,12 +82,13 @@ pub fn scene_glb_bytes(
     for m in morphs {
         m.validate(name)?;
     }
-    encode(name, skinned, animation, morphs)
+    encode(name, skinned, &[], animation, morphs)
 }
 
 fn encode(
     path: &Path,
     skinned: &SkinnedMesh,
+    layers: &[SkinnedLayer],
     animation: Option<&SkeletalAnimation>,
     morphs: &[MorphSequence],
 ) -> Result<Vec<u8>, MeshFileError> {
@@ -75,7 +96,7 @@ fn encode(
     let joints = skeleton.joint_count();
     let mut buffer = Buffer::default();
 
-    let primitive = primitive(path, skinned, &mut buffer)?;
+    let body = primitive(path, &skinned.mesh, &skinned.weights, joints, &mut buffer)?;
     let ibm: Vec<[f32; 16]> = skeleton
         .bind_joints
         .iter()
@@ -105,11 +126,18 @@ fn encode(
         })
         .collect();
     nodes.push(json!({ "name": "body", "mesh": 0, "skin": 0 }));
-    let mut meshes = vec![json!({ "name": "body", "primitives": [primitive] })];
+    let mut meshes = vec![json!({ "name": "body", "primitives": [body] })];
     let mut roots = vec![0, joints];
-    for (i, m) in morphs.iter().enumerate() {
+    for l in layers {
+        let layer = primitive(path, &l.mesh, &l.weights, joints, &mut buffer)?;
         roots.push(nodes.len());
-        nodes.push(json!({ "name": m.name, "mesh": i + 1 }));
+        nodes.push(json!({ "name": l.name, "mesh": meshes.len(), "skin": 0 }));
+        meshes.push(json!({ "name": l.name, "primitives": [layer] }));
+    }
+    let first_morph = nodes.len();
+    for m in morphs {
+        roots.push(nodes.len());
+        nodes.push(json!({ "name": m.name, "mesh": meshes.len() }));
         meshes.push(m.mesh_json(&mut buffer));
     }
 
@@ -126,7 +154,7 @@ fn encode(
         skeletal_tracks(a, skeleton.bind_joints[0], &mut buffer, &mut track);
     }
     for (i, m) in morphs.iter().enumerate() {
-        track.add(m.weights_sampler(&mut buffer), joints + 1 + i, "weights");
+        track.add(m.weights_sampler(&mut buffer), first_morph + i, "weights");
     }
     if !track.channels.is_empty() {
         doc["animations"] =
@@ -154,9 +182,13 @@ pub(crate) fn finish(path: &Path, mut doc: Value, buffer: Buffer) -> Result<Vec<
 
 /// The mesh primitive: seam-split vertices with POSITION, NORMAL, optional TEXCOORD_0 and
 /// COLOR_0, and the four strongest skinning influences.
-fn primitive(path: &Path, skinned: &SkinnedMesh, buffer: &mut Buffer) -> Result<Value, MeshFileError> {
-    let mesh = &skinned.mesh;
-    let joints = skinned.skeleton.joint_count();
+fn primitive(
+    path: &Path,
+    mesh: &TriMesh,
+    weights: &[f32],
+    joints: usize,
+    buffer: &mut Buffer,
+) -> Result<Value, MeshFileError> {
     let split = split_uv_seams(mesh);
     let source: Vec<usize> = split.source.iter().map(|&v| v as usize).collect();
 
@@ -166,7 +198,7 @@ fn primitive(path: &Path, skinned: &SkinnedMesh, buffer: &mut Buffer) -> Result<
     let normal = |v: usize| if normals[v] == [0.0; 3] { [0.0, 1.0, 0.0] } else { normals[v] };
     let mut influences = Vec::with_capacity(source.len());
     for &v in &source {
-        influences.push(top_four(&skinned.weights[v * joints..(v + 1) * joints]).ok_or_else(|| {
+        influences.push(top_four(&weights[v * joints..(v + 1) * joints]).ok_or_else(|| {
             MeshFileError::format(
                 path,
                 format!("weights[vertex {v}]"),
@@ -192,8 +224,8 @@ fn primitive(path: &Path, skinned: &SkinnedMesh, buffer: &mut Buffer) -> Result<
     }
     let joint_ids: Vec<[u32; 4]> = influences.iter().map(|(j, _)| j.map(u32::from)).collect();
     attributes["JOINTS_0"] = json!(buffer.ints(&joint_ids, joint_kind, Some(ARRAY_BUFFER)));
-    let weights: Vec<[f32; 4]> = influences.iter().map(|(_, w)| *w).collect();
-    attributes["WEIGHTS_0"] = json!(buffer.floats(&weights, false, Some(ARRAY_BUFFER)));
+    let strongest: Vec<[f32; 4]> = influences.iter().map(|(_, w)| *w).collect();
+    attributes["WEIGHTS_0"] = json!(buffer.floats(&strongest, false, Some(ARRAY_BUFFER)));
 
     let indices: Vec<[u32; 1]> = split.faces.iter().flatten().map(|&i| [i]).collect();
     let indices = buffer.ints(&indices, Int::U32, Some(ELEMENT_ARRAY_BUFFER));

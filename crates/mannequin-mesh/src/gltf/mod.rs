@@ -12,6 +12,6 @@ mod morph;
 mod split;
 
 pub use blend_shapes::{BlendShapeAnimation, BlendShapeMesh, write_blend_shape_glb};
-pub use document::{scene_glb_bytes, write_glb, write_scene_glb};
-pub use model::{SkeletalAnimation, Skeleton, SkinnedMesh};
+pub use document::{scene_glb_bytes, write_glb, write_layered_glb, write_scene_glb};
+pub use model::{SkeletalAnimation, Skeleton, SkinnedLayer, SkinnedMesh};
 pub use morph::MorphSequence;

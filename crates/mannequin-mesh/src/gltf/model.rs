@@ -29,6 +29,33 @@ pub struct SkinnedMesh {
     pub weights: Vec<f32>,
 }
 
+/// A mesh skinned by a [`SkinnedMesh`]'s skeleton, written as a node of its own (a garment).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkinnedLayer {
+    pub name: String,
+    pub mesh: TriMesh,
+    /// V×J weights, row-major, in the skeleton's joints.
+    pub weights: Vec<f32>,
+}
+
+impl SkinnedLayer {
+    pub(crate) fn validate(&self, path: &Path, joints: usize) -> Result<(), MeshFileError> {
+        let expected = self.mesh.vertex_count() * joints;
+        if self.weights.len() != expected {
+            return Err(invalid(
+                path,
+                format!("layer {} weights", self.name),
+                format!(
+                    "{expected} values ({} vertices × {joints} joints), found {}",
+                    self.mesh.vertex_count(),
+                    self.weights.len()
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A motion for a skeleton: one pose per frame at a fixed rate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SkeletalAnimation {
