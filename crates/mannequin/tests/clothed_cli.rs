@@ -37,7 +37,7 @@ fn train(data: &Path, model: &Path, garments: &str, iters: &str) -> std::process
         "--checkpoint-every",
         "2",
         "--garment-iters",
-        "100",
+        "40",
     ])
 }
 
@@ -112,7 +112,17 @@ fn a_clothed_avatar_trains_exports_and_scores_its_garment_layers() {
 
     // `eval` scores each garment layer against the dataset's ground-truth garment meshes.
     let scores_path = dir.join("scores.json");
-    ok(mannequin(&["eval", "--avatar", s(&model), "--data", s(&data), "--json", s(&scores_path)]));
+    ok(mannequin(&[
+        "eval",
+        "--avatar",
+        s(&model),
+        "--data",
+        s(&data),
+        "--samples",
+        "4000",
+        "--json",
+        s(&scores_path),
+    ]));
     let scores = read_json(&scores_path);
     for name in ["pants", "tshirt"] {
         let chamfer = scores["geometry"]["garments"][name]["chamfer_cm"].as_f64().unwrap();
