@@ -16,23 +16,10 @@ use std::path::{Path, PathBuf};
 mod bench_args;
 #[path = "../../../tools/bench_cli.rs"]
 mod bench_cli;
-use bench_cli::mannequin;
+use bench_cli::{mannequin, subject};
 
 /// The training-time target for 100 frames, seconds.
 const TARGET_S: f64 = 600.0;
-
-/// A subject of seed `seed`, made once and kept between runs (synth is deterministic).
-fn subject(seed: u64, root: &Path, cache: &Path) -> PathBuf {
-    let dir = root.join(format!("subject-{seed}"));
-    if !dir.join("subject.json").exists() {
-        let _ = std::fs::remove_dir_all(&dir);
-        mannequin(
-            &["synth".into(), "--seed".into(), seed.to_string(), "--out".into(), dir.display().to_string()],
-            cache,
-        );
-    }
-    dir
-}
 
 /// The garment categories the subject's label legend holds.
 fn garments(data: &Path) -> Vec<String> {
