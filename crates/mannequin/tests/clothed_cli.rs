@@ -6,15 +6,11 @@
 use std::path::Path;
 
 mod common;
-use common::{mannequin, ok, one_line_error, s, scratch};
+use common::{mannequin, ok, one_line_error, read_json, s, scratch};
 
 #[path = "../../../tools/node_checks.rs"]
 mod node_checks;
 use node_checks::KHRONOS_VALIDATOR;
-
-fn read_json(path: &Path) -> serde_json::Value {
-    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
-}
 
 /// The JSON chunk of a `.glb` (its first chunk, after the 12-byte header and 8-byte chunk header).
 fn glb_json(path: &Path) -> serde_json::Value {

@@ -9,16 +9,12 @@
 use std::path::Path;
 
 mod common;
-use common::{mannequin, ok, one_line_error, s, scratch};
+use common::{mannequin, ok, one_line_error, read_json, s, scratch};
 use mannequin_mesh::PointCache;
 
 #[path = "../../../tools/node_checks.rs"]
 mod node_checks;
 use node_checks::KHRONOS_VALIDATOR;
-
-fn read_json(path: &Path) -> serde_json::Value {
-    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
-}
 
 #[test]
 fn a_made_template_reads_back() {

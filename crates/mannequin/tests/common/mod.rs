@@ -83,3 +83,8 @@ pub fn tiny_avatar(dir: &Path) -> (PathBuf, PathBuf) {
     ]));
     (data, model)
 }
+
+/// A JSON file the program wrote.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
