@@ -158,3 +158,30 @@ fn sizes_that_do_not_divide_name_the_files() {
         std::fs::remove_dir_all(d).unwrap();
     }
 }
+
+/// Garment meshes (`meshes/garment_<name>_%04d.ply`) are scored per garment where both folders
+/// have them: a garment only the prediction has is not scored, and the summary is the mean of
+/// the frames'.
+#[test]
+fn each_garment_is_scored_against_its_own_ground_truth() {
+    let gt = write_gt("gt-garments", 32, 3);
+    let pred = temp_dir("pred-garments");
+    let (wg, wp) = (DatasetWriter::new(&gt), DatasetWriter::new(&pred));
+    for (i, shift) in [(0, 0.02), (2, 0.0)] {
+        wg.write_garment_mesh(i, "skirt", &tetrahedron(0.0)).unwrap();
+        wp.write_frame(&perfect_prediction(i, 32)).unwrap();
+        wp.write_garment_mesh(i, "skirt", &tetrahedron(shift)).unwrap();
+        wp.write_garment_mesh(i, "cape", &tetrahedron(0.0)).unwrap();
+    }
+    let s = evaluate(&pred, &gt, &[0, 2], &options(), &|_| {}).unwrap();
+    let p2s: Vec<f64> = s.per_frame.iter().map(|f| f.garments["skirt"].p2s_cm).collect();
+    // Shifted by 2 cm, no point is farther than 2 cm; unshifted, every point is on it.
+    assert!(p2s[0] > 0.2 && p2s[0] <= 2.0 + 1e-6, "{p2s:?}");
+    assert!(p2s[1] < 1e-6, "{p2s:?}");
+    assert!((s.garments["skirt"].p2s_cm - (p2s[0] + p2s[1]) / 2.0).abs() < 1e-12);
+    assert_eq!(s.garments.keys().collect::<Vec<_>>(), ["skirt"]);
+    assert!(s.per_frame.iter().all(|f| !f.garments.contains_key("cape")));
+    for d in [gt, pred] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
+}
