@@ -4,10 +4,11 @@
 
 use std::path::Path;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use mannequin_avatar::garment_layer::GarmentLayer;
-use mannequin_data::layout;
+use mannequin_data::{Fingerprint, layout};
 use mannequin_garment::Category;
+use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::garment_fit::{NgdArgs, label_legend, reconstruct};
 
@@ -65,11 +66,17 @@ fn parse_item(item: &str) -> Result<Category> {
     }
 }
 
+/// Where a finished reconstruction is kept beside its fit, with the record of what made it.
+const KEPT: &str = "layer.npz";
+
 /// Reconstructs each of `garments` with `garment fit`'s defaults but its seed and steps,
-/// writing each fit into `out/garments/<category>/`, and returns them as avatar layers.
+/// writing each fit into `out/garments/<category>/`, and returns them as avatar layers. A
+/// garment whose folder keeps a finished reconstruction of the same `data` (by its
+/// fingerprint), body, seed and steps is read back instead of fitted again, so a run stopped
+/// after its first garments goes on from there.
 pub fn reconstruct_all(
     garments: &[Category],
-    data: &Path,
+    (data, fingerprint): (&Path, &Fingerprint),
     body: &str,
     (seed, steps): (u64, usize),
     out: &Path,
@@ -80,15 +87,62 @@ pub fn reconstruct_all(
         .iter()
         .map(|c| {
             let dir = out.join("garments").join(c.name());
+            let record =
+                serde_json::json!({ "category": c.name(), "body": body, "seed": seed, "steps": steps, "data": fingerprint })
+                    .to_string();
+            if let Some(layer) = read_kept(&dir.join(KEPT), &record)? {
+                tracing::info!("the {} reconstructed earlier is kept in {}: reusing it", c.name(), dir.display());
+                return Ok(layer);
+            }
             let fitted = reconstruct(data, c.name(), c.name(), body, &ngd, &dir)?;
-            Ok(GarmentLayer {
+            let layer = GarmentLayer {
                 name: fitted.category,
                 positions: fitted.positions,
                 faces: fitted.faces,
                 weights: fitted.weights,
-            })
+            };
+            keep(&dir.join(KEPT), &layer, &record)?;
+            Ok(layer)
         })
         .collect()
+}
+
+fn keep(path: &Path, layer: &GarmentLayer, record: &str) -> Result<()> {
+    let mut w = NpzWriter::new();
+    w.add("record", NpyArray::text(record));
+    let v = layer.positions.len();
+    w.add("positions", NpyArray::f32(vec![v, 3], layer.positions.iter().flatten().copied().collect()));
+    let faces = layer.faces.iter().flatten().map(|&i| i64::from(i)).collect();
+    w.add("faces", NpyArray::i64(vec![layer.faces.len(), 3], faces));
+    w.add("weights", NpyArray::f32(vec![v, layer.weights.len() / v.max(1)], layer.weights.clone()));
+    w.write(path).with_context(|| format!("writing {}", path.display()))
+}
+
+/// The layer kept at `path` if it was made as `record` says; `None` if there is none or it was
+/// made another way.
+fn read_kept(path: &Path, record: &str) -> Result<Option<GarmentLayer>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let npz = Npz::read(path)?;
+    if npz.text("record")? != record {
+        return Ok(None);
+    }
+    let (_, positions) = npz.f64_with_shape("positions", &[None, Some(3)])?;
+    let v = positions.len() / 3;
+    let (_, faces) = npz.f64_with_shape("faces", &[None, Some(3)])?;
+    let (_, weights) = npz.f64_with_shape("weights", &[Some(v), None])?;
+    if let Some(f) = faces.iter().position(|&i| i < 0.0 || i as usize >= v) {
+        bail!("{}: faces: face {} indexes past the {v} vertices", path.display(), f / 3);
+    }
+    let category: String =
+        serde_json::from_str::<serde_json::Value>(record)?["category"].as_str().unwrap_or("").into();
+    Ok(Some(GarmentLayer {
+        name: category,
+        positions: positions.chunks_exact(3).map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]).collect(),
+        faces: faces.chunks_exact(3).map(|f| [f[0] as u32, f[1] as u32, f[2] as u32]).collect(),
+        weights: weights.into_iter().map(|w| w as f32).collect(),
+    }))
 }
 
 #[cfg(test)]

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
-use mannequin_avatar::avatar::PARAMS_FILE;
 use mannequin_avatar::skirt_layer;
 use mannequin_avatar::trainer::checkpoint_path;
 use mannequin_avatar::{
@@ -174,25 +173,18 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
     if views.iter().any(|v| !v.has_normals()) {
         tracing::warn!("{} has no normal maps: the normal loss is off", args.data.display());
     }
-    let saved = args.out.join(PARAMS_FILE);
-    let canonical = if resume && !garments.is_empty() && saved.exists() {
-        // The garments were reconstructed when this run began; the model folder kept them.
-        Canonical::read(&Npz::read(&saved)?, &saved)?
-    } else {
-        let layers = garment_layers::reconstruct_all(
-            &garments,
-            &args.data,
-            &args.body,
-            (args.seed, args.garment_iters),
-            &args.out,
-        )?;
-        let (canonical, skirt_layer) =
-            Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, skirt, &layers)?;
-        if let Some(layer) = &skirt_layer {
-            tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
-        }
-        canonical
-    };
+    let layers = garment_layers::reconstruct_all(
+        &garments,
+        (&args.data, &record.data),
+        &args.body,
+        (args.seed, args.garment_iters),
+        &args.out,
+    )?;
+    let (canonical, skirt_layer) =
+        Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, skirt, &layers)?;
+    if let Some(layer) = &skirt_layer {
+        tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
+    }
     record.avatar.skirt_layer = canonical.layer_names.iter().any(|n| n == skirt_layer::LAYER_NAME);
     let device = args.device.device()?.autodiff();
     let avatar = Avatar::new(record.avatar.clone(), canonical, &device)?;

@@ -60,11 +60,11 @@ fn a_clothed_avatar_trains_exports_and_scores_its_garment_layers() {
         |c: &str| mannequin_mesh::read_obj(model.join("garments").join(c).join("garment.obj")).unwrap();
     let (pants, tshirt) = (fitted("pants"), fitted("tshirt"));
 
-    // Resuming reads the garments from the model folder instead of fitting them again; other
+    // Resuming reads the garments kept in the model folder instead of fitting them again; other
     // garments are another run.
     let resumed = ok(train(&data, &model, "auto", "2"));
     let log = String::from_utf8_lossy(&resumed.stderr);
-    assert!(log.contains("resuming") && !log.contains("fitted the"), "{log}");
+    assert!(log.contains("resuming") && log.contains("reusing it") && !log.contains("fitted the"), "{log}");
     one_line_error(&train(&data, &model, "upper:tshirt", "2"), &["checkpoint.npz", "garments", "--restart"]);
 
     // The `.obj` export: the whole clothed mesh, and each garment beside it, with the fitted
