@@ -26,8 +26,8 @@ pub use area::double_areas;
 pub use closest_point::{ClosestPoint, SurfacePoint};
 pub use file_error::MeshFileError;
 pub use gltf::{
-    BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh,
-    write_blend_shape_glb, write_glb, write_scene_glb,
+    BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedLayer,
+    SkinnedMesh, write_blend_shape_glb, write_glb, write_layered_glb, write_scene_glb,
 };
 pub use gradient::gradient_operator;
 pub use laplacian::cotan_laplacian;

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use mannequin_mesh::{
-    BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedMesh, TriMesh,
-    UvLayout, write_blend_shape_glb, write_glb, write_scene_glb,
+    BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedLayer,
+    SkinnedMesh, TriMesh, UvLayout, write_blend_shape_glb, write_glb, write_layered_glb, write_scene_glb,
 };
 use serde_json::Value;
 
@@ -413,6 +413,46 @@ fn bad_inputs_are_errors_naming_the_field() {
     arm.weights[..12].fill(0.0);
     let e = write_glb(&path, &arm, None).unwrap_err().to_string();
     assert!(e.contains("weights[vertex 0]") && e.contains("positive"), "{e}");
+    assert!(!path.exists(), "nothing is written on error");
+}
+
+/// A layer (a sleeve over the arm) is a skinned node of its own on the body's skeleton, with its
+/// own vertices and the body's joints; a layer whose weights do not fit is refused by name.
+#[test]
+fn layers_are_skinned_nodes_of_their_own() {
+    let path = temp_file("layered.glb");
+    let arm = arm();
+    let mut sleeve = TriMesh::new(
+        arm.mesh.positions.iter().map(|&[x, y, z]| [x, 1.5 * y, 1.5 * z]).collect(),
+        arm.mesh.faces.clone(),
+    );
+    sleeve.colors = None;
+    let layer = SkinnedLayer { name: "sleeve".into(), mesh: sleeve, weights: arm.weights.clone() };
+    write_layered_glb(&path, &arm, std::slice::from_ref(&layer), Some(&motion())).unwrap();
+    let glb = Glb::read(&path);
+    let skinned: Vec<(&str, u64)> = glb.doc["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|n| n.get("skin").is_some())
+        .map(|n| (n["name"].as_str().unwrap(), n["mesh"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(skinned, [("body", 0), ("sleeve", 1)]);
+    let attributes = &glb.doc["meshes"][1]["primitives"][0]["attributes"];
+    let positions = glb.accessor(&attributes["POSITION"]);
+    // No UV seam to split: the sleeve's own 20 vertices, 1.5 times the arm's radius.
+    assert_eq!(positions.len(), 20);
+    assert!(positions.iter().all(|p| (p[1].abs() - 0.15).abs() < 1e-6 && (p[2].abs() - 0.15).abs() < 1e-6));
+    let joints = glb.accessor(&attributes["JOINTS_0"]);
+    assert_eq!(joints[19][0], 2.0, "the wrist ring follows the wrist");
+    let report = KHRONOS_VALIDATOR.run(&path);
+    std::fs::remove_file(&path).unwrap();
+    if let Some(report) = report {
+        assert!(report.contains(" 0 errors, 0 warnings"), "{report}");
+    }
+    let bad = SkinnedLayer { weights: arm.weights[..59].to_vec(), ..layer };
+    let e = write_layered_glb(&path, &arm, &[bad], None).unwrap_err().to_string();
+    assert!(e.contains("layer sleeve weights") && e.contains("60 values"), "{e}");
     assert!(!path.exists(), "nothing is written on error");
 }
 

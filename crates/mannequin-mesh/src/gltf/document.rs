@@ -56,14 +56,7 @@ pub fn write_layered_glb(
     animation: Option<&SkeletalAnimation>,
 ) -> Result<(), MeshFileError> {
     let path = path.as_ref();
-    skinned.validate(path)?;
-    if let Some(a) = animation {
-        a.validate(path, skinned.skeleton.joint_count())?;
-    }
-    for l in layers {
-        l.validate(path, skinned.skeleton.joint_count())?;
-    }
-    let bytes = encode(path, skinned, layers, animation, &[])?;
+    let bytes = validated_bytes(path, skinned, layers, animation, &[])?;
     mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
 }
 
@@ -75,14 +68,29 @@ pub fn scene_glb_bytes(
     animation: Option<&SkeletalAnimation>,
     morphs: &[MorphSequence],
 ) -> Result<Vec<u8>, MeshFileError> {
+    validated_bytes(name, skinned, &[], animation, morphs)
+}
+
+/// Every part checked, then encoded.
+fn validated_bytes(
+    name: &Path,
+    skinned: &SkinnedMesh,
+    layers: &[SkinnedLayer],
+    animation: Option<&SkeletalAnimation>,
+    morphs: &[MorphSequence],
+) -> Result<Vec<u8>, MeshFileError> {
     skinned.validate(name)?;
+    let joints = skinned.skeleton.joint_count();
     if let Some(a) = animation {
-        a.validate(name, skinned.skeleton.joint_count())?;
+        a.validate(name, joints)?;
+    }
+    for l in layers {
+        l.validate(name, joints)?;
     }
     for m in morphs {
         m.validate(name)?;
     }
-    encode(name, skinned, &[], animation, morphs)
+    encode(name, skinned, layers, animation, morphs)
 }
 
 fn encode(
