@@ -43,7 +43,7 @@ pub fn write_scene_glb(
     morphs: &[MorphSequence],
 ) -> Result<(), MeshFileError> {
     let path = path.as_ref();
-    let bytes = scene_glb_bytes(path, skinned, animation, morphs)?;
+    let bytes = scene_glb_bytes(path, skinned, &[], animation, morphs)?;
     mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
 }
 
@@ -56,23 +56,13 @@ pub fn write_layered_glb(
     animation: Option<&SkeletalAnimation>,
 ) -> Result<(), MeshFileError> {
     let path = path.as_ref();
-    let bytes = validated_bytes(path, skinned, layers, animation, &[])?;
+    let bytes = scene_glb_bytes(path, skinned, layers, animation, &[])?;
     mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
 }
 
-/// The bytes [`write_scene_glb`] writes, for a server that sends them instead; `name` names the
-/// file in errors.
+/// The bytes [`write_scene_glb`] and [`write_layered_glb`] write, every part checked, for a
+/// server that sends them instead; `name` names the file in errors.
 pub fn scene_glb_bytes(
-    name: &Path,
-    skinned: &SkinnedMesh,
-    animation: Option<&SkeletalAnimation>,
-    morphs: &[MorphSequence],
-) -> Result<Vec<u8>, MeshFileError> {
-    validated_bytes(name, skinned, &[], animation, morphs)
-}
-
-/// Every part checked, then encoded.
-fn validated_bytes(
     name: &Path,
     skinned: &SkinnedMesh,
     layers: &[SkinnedLayer],

@@ -128,11 +128,13 @@ impl Site {
         if named.is_empty() {
             named.push(("procedural walk".into(), Motion::walk_cycle(WALK.0, WALK.1)));
         }
-        let skinned = export::skinned_mesh(&avatar, &canonical)?;
+        // Garment layers are nodes of their own, so each is a toggle.
+        let (body, garments) = export::skinned_layers(&avatar, &canonical)?;
         let mut offered = Vec::new();
         for (k, (name, motion)) in named.iter().enumerate() {
             let animation = avatar_animation(&avatar, motion)?;
-            let glb = scene_glb_bytes(&dir.join(format!("{name}.glb")), &skinned, Some(&animation), &[])?;
+            let glb =
+                scene_glb_bytes(&dir.join(format!("{name}.glb")), &body, &garments, Some(&animation), &[])?;
             self.generated.insert(format!("motion_{k}.glb"), ("model/gltf-binary", glb));
             offered.push(json!({ "name": name, "url": format!("/generated/motion_{k}.glb") }));
         }
