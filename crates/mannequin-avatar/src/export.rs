@@ -297,9 +297,8 @@ pub fn skinned_layers(
     let canonical = &avatar.canonical;
     let j = canonical.num_joints();
     let part = |name: &str| -> (TriMesh, Vec<f32>) {
-        let (kept, _) = canonical.layer_part(name).expect("a layer the canonical mesh names");
-        let mesh = canonical.layer_mesh(name, &whole.mesh).expect("a layer the canonical mesh names");
-        (mesh, kept.iter().flat_map(|&v| whole.weights[v * j..(v + 1) * j].iter().copied()).collect())
+        let part = canonical.layer_part(name).expect("a layer the canonical mesh names");
+        (part.mesh(&whole.mesh), part.rows(&whole.weights, j))
     };
     let layers = canonical
         .garment_names()

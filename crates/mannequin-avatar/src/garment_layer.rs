@@ -52,6 +52,29 @@ impl GarmentLayer {
     }
 }
 
+/// One layer of a canonical mesh as a mesh of its own: the whole mesh's vertices it keeps, in
+/// order, and its faces renumbered to index them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayerPart {
+    pub vertices: Vec<usize>,
+    pub faces: Vec<[u32; 3]>,
+}
+
+impl LayerPart {
+    /// This part of `whole` (the canonical mesh's faces, in any pose, with any colours).
+    pub fn mesh(&self, whole: &TriMesh) -> TriMesh {
+        let mut part =
+            TriMesh::new(self.vertices.iter().map(|&i| whole.positions[i]).collect(), self.faces.clone());
+        part.colors = whole.colors.as_ref().map(|c| self.vertices.iter().map(|&i| c[i]).collect());
+        part
+    }
+
+    /// This part's rows of a per-vertex table `width` values wide (skinning weights, say).
+    pub fn rows(&self, table: &[f32], width: usize) -> Vec<f32> {
+        self.vertices.iter().flat_map(|&v| table[v * width..(v + 1) * width].iter().copied()).collect()
+    }
+}
+
 impl Canonical {
     /// The mesh with `layer` appended as a layer of its own (no pose correctives on it), the
     /// body's offsets gated by `body_gate` (one value per vertex of the mesh so far; the lesser
@@ -99,15 +122,14 @@ impl Canonical {
         &self.layer_names[1..]
     }
 
-    /// Layer `name` as a mesh of its own: the mesh's vertices it keeps, in order, and its faces
-    /// renumbered to index them. `None` when there is no such layer.
-    pub fn layer_part(&self, name: &str) -> Option<(Vec<usize>, Vec<[u32; 3]>)> {
+    /// Layer `name` as a mesh of its own; `None` when there is no such layer.
+    pub fn layer_part(&self, name: &str) -> Option<LayerPart> {
         let index = self.layer_names.iter().position(|n| n == name)? as u8;
         let mut renumbered = vec![u32::MAX; self.num_vertices()];
-        let mut kept = Vec::new();
+        let mut vertices = Vec::new();
         for i in (0..self.num_vertices()).filter(|&i| self.layer[i] == index) {
-            renumbered[i] = kept.len() as u32;
-            kept.push(i);
+            renumbered[i] = vertices.len() as u32;
+            vertices.push(i);
         }
         let faces = self
             .faces
@@ -115,15 +137,12 @@ impl Canonical {
             .filter(|f| self.layer[f[0] as usize] == index)
             .map(|f| f.map(|i| renumbered[i as usize]))
             .collect();
-        Some((kept, faces))
+        Some(LayerPart { vertices, faces })
     }
 
     /// Layer `name`'s part of `mesh` (this mesh's faces, in any pose, with any colours).
     pub fn layer_mesh(&self, name: &str, mesh: &TriMesh) -> Option<TriMesh> {
-        let (kept, faces) = self.layer_part(name)?;
-        let mut part = TriMesh::new(kept.iter().map(|&i| mesh.positions[i]).collect(), faces);
-        part.colors = mesh.colors.as_ref().map(|c| kept.iter().map(|&i| c[i]).collect());
-        Some(part)
+        Some(self.layer_part(name)?.mesh(mesh))
     }
 }
 

@@ -73,6 +73,12 @@ pub fn predict_split(
 ) -> Result<(), AvatarError> {
     let split = dataset.split(split)?;
     let writer = DatasetWriter::new(out);
+    let garments: Vec<_> = avatar
+        .canonical
+        .garment_names()
+        .iter()
+        .filter_map(|name| Some((name, avatar.canonical.layer_part(name)?)))
+        .collect();
     for (i, &frame) in split.frames.iter().enumerate() {
         let camera = frame_camera(dataset, frame);
         let p = predict(avatar, &camera, &split.poses.pose72(i), split.poses.transl[i])?;
@@ -84,10 +90,8 @@ pub fn predict_split(
             depth: Some(p.depth),
         })?;
         writer.write_mesh(frame, &p.mesh)?;
-        for name in avatar.canonical.garment_names() {
-            if let Some(part) = avatar.canonical.layer_mesh(name, &p.mesh) {
-                writer.write_garment_mesh(frame, name, &part)?;
-            }
+        for (name, part) in &garments {
+            writer.write_garment_mesh(frame, name, &part.mesh(&p.mesh))?;
         }
         on_frame();
     }

@@ -24,7 +24,7 @@ use crate::garment_layer::GarmentLayer;
 use crate::views::View;
 
 /// The layer's name among the canonical mesh's layers.
-pub const LAYER_NAME: &str = "skirt_layer";
+const LAYER_NAME: &str = "skirt_layer";
 /// Radial step of the carving search (m): about a pixel at 540×540 on a standing subject.
 const STEP: f32 = 0.003;
 /// How far past the body's own outline the hull is searched (m).

@@ -90,7 +90,7 @@ pub fn reconstruct_all(
             let record =
                 serde_json::json!({ "category": c.name(), "body": body, "seed": seed, "steps": steps, "data": fingerprint })
                     .to_string();
-            if let Some(layer) = read_kept(&dir.join(KEPT), &record)? {
+            if let Some(layer) = read_kept(&dir.join(KEPT), &record, c.name())? {
                 tracing::info!("the {} reconstructed earlier is kept in {}: reusing it", c.name(), dir.display());
                 return Ok(layer);
             }
@@ -120,7 +120,7 @@ fn keep(path: &Path, layer: &GarmentLayer, record: &str) -> Result<()> {
 
 /// The layer kept at `path` if it was made as `record` says; `None` if there is none or it was
 /// made another way.
-fn read_kept(path: &Path, record: &str) -> Result<Option<GarmentLayer>> {
+fn read_kept(path: &Path, record: &str, name: &str) -> Result<Option<GarmentLayer>> {
     if !path.exists() {
         return Ok(None);
     }
@@ -135,10 +135,8 @@ fn read_kept(path: &Path, record: &str) -> Result<Option<GarmentLayer>> {
     if let Some(f) = faces.iter().position(|&i| i < 0.0 || i as usize >= v) {
         bail!("{}: faces: face {} indexes past the {v} vertices", path.display(), f / 3);
     }
-    let category: String =
-        serde_json::from_str::<serde_json::Value>(record)?["category"].as_str().unwrap_or("").into();
     Ok(Some(GarmentLayer {
-        name: category,
+        name: name.to_string(),
         positions: positions.chunks_exact(3).map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]).collect(),
         faces: faces.chunks_exact(3).map(|f| [f[0] as u32, f[1] as u32, f[2] as u32]).collect(),
         weights: weights.into_iter().map(|w| w as f32).collect(),

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
-use mannequin_avatar::skirt_layer;
 use mannequin_avatar::trainer::checkpoint_path;
 use mannequin_avatar::{
     Avatar, AvatarConfig, AvatarError, Canonical, GarmentRecord, Method, SkirtMode, TrainOptions, Trainer,
@@ -185,7 +184,7 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
     if let Some(layer) = &skirt_layer {
         tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
     }
-    record.avatar.skirt_layer = canonical.layer_names.iter().any(|n| n == skirt_layer::LAYER_NAME);
+    record.avatar.skirt_layer = skirt_layer.is_some();
     let device = args.device.device()?.autodiff();
     let avatar = Avatar::new(record.avatar.clone(), canonical, &device)?;
     let mut trainer = Trainer::new(avatar, views, record.options.clone())?;
