@@ -4,6 +4,7 @@
 
 use faer::{Accum, MatMut, MatRef, Par};
 use glam::{Affine3A, Mat3, Mat3A, Vec3, Vec3A};
+use mannequin_io::limits::MAX_BETA;
 use rayon::prelude::*;
 
 use crate::error::BodyError;
@@ -52,8 +53,11 @@ pub fn shape_body(model: &BodyModel, shape: &[f32]) -> Result<ShapedBody, BodyEr
             format!("{} coefficients given, the model has {n}", shape.len()),
         ));
     }
-    if let Some(i) = shape.iter().position(|x| !x.is_finite()) {
-        return Err(BodyError::input("shape", format!("coefficient {i} is not finite")));
+    if let Some(i) = shape.iter().position(|x| !(f64::from(x.abs()) <= MAX_BETA)) {
+        return Err(BodyError::input(
+            "shape",
+            format!("coefficient {i} is {}: expected a finite value within ±{MAX_BETA}", shape[i]),
+        ));
     }
     let mut vertices: Vec<f32> = model.v_template.iter().flatten().copied().collect();
     let len = vertices.len();

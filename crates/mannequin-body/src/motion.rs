@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Quat;
+use mannequin_io::limits::{MAX_BETA, MAX_DISTANCE, MAX_MOTION_FRAMES};
 use mannequin_io::{NpyArray, NpyData, Npz, NpzWriter};
 
 use crate::error::BodyError;
@@ -44,20 +45,43 @@ fn scalar_f64(npz: &Npz, key: &str) -> Result<f64, BodyError> {
     }
 }
 
-/// A clip needs a first frame: every use of one (resampling, posing, export) starts there.
+/// A clip needs a first frame: every use of one (resampling, posing, export) starts there; and
+/// at most [`MAX_MOTION_FRAMES`], since every use also allocates per frame.
 fn check_frames(npz: &Npz, key: &str, shape: &[usize]) -> Result<(), BodyError> {
-    if shape[0] == 0 {
+    if shape[0] == 0 || shape[0] > MAX_MOTION_FRAMES {
         return Err(npz
-            .field_error(key, format!("expected at least one frame, found shape {shape:?}"))
+            .field_error(
+                key,
+                format!("expected at least one frame and at most {MAX_MOTION_FRAMES}, found shape {shape:?}"),
+            )
             .into());
     }
     Ok(())
 }
 
-fn check_finite(npz: &Npz, key: &str, values: &[f32], per_frame: usize) -> Result<(), BodyError> {
-    match values.iter().position(|x| !x.is_finite()) {
+/// Shape coefficients, finite and within [`MAX_BETA`].
+fn check_betas(npz: &Npz, betas: &[f64]) -> Result<(), BodyError> {
+    match betas.iter().position(|b| !(b.abs() <= MAX_BETA)) {
         Some(i) => Err(npz
-            .field_error(key, format!("frame {} holds a non-finite value", i / per_frame.max(1)))
+            .field_error("betas", format!("element {i} is {}: expected within ±{MAX_BETA}", betas[i]))
+            .into()),
+        None => Ok(()),
+    }
+}
+
+/// Every value finite and within `bound` (rotations need only be finite; a translation is held
+/// to [`MAX_DISTANCE`]).
+fn check_values(npz: &Npz, key: &str, values: &[f32], per_frame: usize, bound: f64) -> Result<(), BodyError> {
+    match values.iter().position(|x| !(f64::from(x.abs()) <= bound)) {
+        Some(i) => Err(npz
+            .field_error(
+                key,
+                format!(
+                    "frame {} holds {}: expected a finite value within ±{bound}",
+                    i / per_frame.max(1),
+                    values[i]
+                ),
+            )
             .into()),
         None => Ok(()),
     }
@@ -83,6 +107,7 @@ impl Motion {
             Some(a) => a.to_f64().ok_or_else(|| npz.field_error("betas", "expected numbers"))?,
             None => Vec::new(),
         };
+        check_betas(npz, &betas)?;
         let fps_key = ["mocap_framerate", "mocap_frame_rate"]
             .into_iter()
             .find(|k| npz.contains(k))
@@ -104,8 +129,8 @@ impl Motion {
         };
         let poses: Vec<f32> = poses.into_iter().map(|x| x as f32).collect();
         let trans: Vec<f32> = trans.into_iter().map(|x| x as f32).collect();
-        check_finite(npz, "poses", &poses, width)?;
-        check_finite(npz, "trans", &trans, 3)?;
+        check_values(npz, "poses", &poses, width, f64::from(f32::MAX))?;
+        check_values(npz, "trans", &trans, 3, MAX_DISTANCE)?;
         Ok(Self {
             source: npz.path.clone(),
             poses,
@@ -125,14 +150,15 @@ impl Motion {
         let (_, body) = npz.f64_with_shape("body_pose", &[Some(frames), Some(69)])?;
         let (_, transl) = npz.f64_with_shape("transl", &[Some(frames), Some(3)])?;
         let (_, betas) = npz.f64_with_shape("betas", &[Some(1), None])?;
+        check_betas(npz, &betas)?;
         let mut poses = Vec::with_capacity(frames * 72);
         for f in 0..frames {
             poses.extend(go[3 * f..3 * f + 3].iter().map(|&x| x as f32));
             poses.extend(body[69 * f..69 * f + 69].iter().map(|&x| x as f32));
         }
         let trans: Vec<f32> = transl.iter().map(|&x| x as f32).collect();
-        check_finite(npz, "global_orient/body_pose", &poses, 72)?;
-        check_finite(npz, "transl", &trans, 3)?;
+        check_values(npz, "global_orient/body_pose", &poses, 72, f64::from(f32::MAX))?;
+        check_values(npz, "transl", &trans, 3, MAX_DISTANCE)?;
         Ok(Self {
             source: npz.path.clone(),
             poses,
@@ -251,6 +277,14 @@ impl Motion {
         }
         let duration = (n - 1) as f64 / self.fps as f64;
         let out_frames = (duration * fps as f64 + 1e-6).floor() as usize + 1;
+        if out_frames > MAX_MOTION_FRAMES {
+            return Err(BodyError::input(
+                "frame rate",
+                format!(
+                    "{fps} fps makes {out_frames} frames of the clip's {n}: expected at most {MAX_MOTION_FRAMES}"
+                ),
+            ));
+        }
         let per = 3 * self.joints;
         let mut poses = Vec::with_capacity(out_frames * per);
         let mut trans = Vec::with_capacity(out_frames * 3);

@@ -183,3 +183,51 @@ fn resampling_far_beyond_the_clip_rate_is_refused() {
     let msg = motion.resample(30.0).unwrap_err().to_string();
     assert!(msg.contains("frame rate") && msg.contains("at most 1000 times"), "{msg}");
 }
+
+/// Values a motion file may hold but no motion has (issue 42): 2 million frames once took 3 GB
+/// in `cloth simulate --max-frames 2`, betas of 1e30 put vertices at 9e28 m, and a translation
+/// of 1e30 m is no walk. Each is refused where the file is read, naming the file and field.
+#[test]
+fn motions_past_the_limits_are_refused() {
+    let dir = Scratch::new("limits-motion");
+    let frames = mannequin_io::limits::MAX_MOTION_FRAMES + 1;
+    let long = dir.join("long.npz");
+    let mut w = NpzWriter::new();
+    w.add("poses", NpyArray::f32(vec![frames, 3], vec![0.0; frames * 3]))
+        .add("trans", NpyArray::f32(vec![frames, 3], vec![0.0; frames * 3]))
+        .add("mocap_framerate", NpyArray::f64(vec![], vec![30.0]));
+    w.write(&long).unwrap();
+    let msg = Motion::read(&long).unwrap_err().to_string();
+    one_line(&msg, "long.npz", "poses");
+    assert!(msg.contains("at most 100000"), "{msg}");
+
+    let path = dir.join("betas.npz");
+    amass(&path, 72, vec![0.0; 144]);
+    let npz = Npz::read(&path).unwrap();
+    let mut w = NpzWriter::new();
+    for k in npz.keys().filter(|&k| k != "betas") {
+        w.add(k, npz.get(k).unwrap().clone());
+    }
+    w.add("betas", NpyArray::f64(vec![2], vec![0.0, 1e30]));
+    w.write(&path).unwrap();
+    let msg = Motion::read(&path).unwrap_err().to_string();
+    one_line(&msg, "betas.npz", "betas");
+    assert!(msg.contains("element 1"), "{msg}");
+
+    let far = dir.join("far.npz");
+    let mut w = NpzWriter::new();
+    w.add("poses", NpyArray::f64(vec![2, 72], vec![0.0; 144]))
+        .add("trans", NpyArray::f64(vec![2, 3], vec![0.0, 0.0, 0.0, 1e30, 0.0, 0.0]))
+        .add("mocap_framerate", NpyArray::f64(vec![], vec![30.0]));
+    w.write(&far).unwrap();
+    let msg = Motion::read(&far).unwrap_err().to_string();
+    one_line(&msg, "far.npz", "trans");
+    assert!(msg.contains("frame 1"), "{msg}");
+
+    let ok = dir.join("ok.npz");
+    amass(&ok, 72, vec![0.0; 72 * 200]);
+    let mut clip = Motion::read(&ok).unwrap();
+    clip.fps = 0.1;
+    let msg = clip.resample(100.0).unwrap_err().to_string();
+    assert!(msg.contains("frame rate") && msg.contains("at most 100000"), "{msg}");
+}

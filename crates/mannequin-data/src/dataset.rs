@@ -67,19 +67,32 @@ impl Cameras {
                 std::array::from_fn(|r| std::array::from_fn(|c| e[4 * r + c])),
             )
         };
-        match (k_shape.as_slice(), e_shape.as_slice()) {
-            ([3, 3], [4, 4]) => Ok(Self::Static(camera(&k, &e))),
-            ([n, 3, 3], [m, 4, 4]) if n == m => Ok(Self::PerFrame(
-                k.chunks_exact(9).zip(e.chunks_exact(16)).map(|(k, e)| camera(k, e)).collect(),
-            )),
-            ([3, 3], [_, 4, 4]) => Ok(Self::PerFrame(e.chunks_exact(16).map(|e| camera(&k, e)).collect())),
-            _ => Err(DataError::file(
-                path,
-                format!(
-                    "expected intrinsic (3,3) or (N,3,3) and extrinsic (4,4) or (N,4,4), found {k_shape:?} and {e_shape:?}"
-                ),
-            )),
+        let cameras = match (k_shape.as_slice(), e_shape.as_slice()) {
+            ([3, 3], [4, 4]) => Self::Static(camera(&k, &e)),
+            ([n, 3, 3], [m, 4, 4]) if n == m => {
+                Self::PerFrame(k.chunks_exact(9).zip(e.chunks_exact(16)).map(|(k, e)| camera(k, e)).collect())
+            }
+            ([3, 3], [_, 4, 4]) => Self::PerFrame(e.chunks_exact(16).map(|e| camera(&k, e)).collect()),
+            _ => {
+                return Err(DataError::file(
+                    path,
+                    format!(
+                        "expected intrinsic (3,3) or (N,3,3) and extrinsic (4,4) or (N,4,4), found {k_shape:?} and {e_shape:?}"
+                    ),
+                ));
+            }
+        };
+        let all = match &cameras {
+            Self::Static(c) => std::slice::from_ref(c),
+            Self::PerFrame(v) => v.as_slice(),
+        };
+        for (i, c) in all.iter().enumerate() {
+            c.validate().map_err(|e| {
+                let which = if all.len() > 1 { format!("camera {i}: ") } else { String::new() };
+                DataError::file(path, format!("{which}{e}"))
+            })?;
         }
+        Ok(cameras)
     }
 }
 
@@ -189,7 +202,7 @@ impl Dataset {
             })
         };
         for (name, range) in &splits {
-            if let Some(&last) = range.frames().last().filter(|&&f| f >= frame_count) {
+            if let Some(last) = Some(range.last()).filter(|&f| f >= frame_count) {
                 return Err(DataError::file(
                     images.path(&root, last),
                     format!(

@@ -10,6 +10,8 @@ use zune_jpeg::zune_core::bytestream::ZCursor;
 use zune_jpeg::zune_core::colorspace::ColorSpace;
 use zune_jpeg::zune_core::options::DecoderOptions;
 
+use mannequin_io::limits::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+
 use crate::error::DataError;
 use crate::image::Image;
 
@@ -46,6 +48,21 @@ fn describe_start(bytes: &[u8]) -> String {
     format!("bytes {}", head.join(" "))
 }
 
+/// Refuses an image whose header claims more than [`MAX_IMAGE_SIDE`] a side or
+/// [`MAX_IMAGE_PIXELS`] in all, before its pixels are allocated: a 74-byte PNG may claim
+/// 65535×65535.
+pub(crate) fn check_size(path: &Path, width: usize, height: usize) -> Result<(), DataError> {
+    if width == 0 || height == 0 || width.max(height) > MAX_IMAGE_SIDE || width * height > MAX_IMAGE_PIXELS {
+        return Err(DataError::file(
+            path,
+            format!(
+                "image size {width}×{height}: expected at most {MAX_IMAGE_SIDE} a side and {MAX_IMAGE_PIXELS} pixels"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl Image {
     /// Decodes a PNG or a JPEG, whichever the bytes hold; `path` names the file in errors.
     pub fn decode(path: &Path, bytes: &[u8]) -> Result<Self, DataError> {
@@ -57,6 +74,32 @@ impl Image {
                 format!("expected a PNG or JPEG image, found {}", describe_start(bytes)),
             )),
         }
+    }
+
+    /// The width and height a PNG or JPEG file's header gives, checked against the limits,
+    /// without decoding its pixels: for checking that a clip's frames agree before any work.
+    pub fn read_size(path: &Path) -> Result<(usize, usize), DataError> {
+        let bytes = std::fs::read(path).map_err(|e| DataError::os(path, e))?;
+        let (w, h) = match ImageFormat::sniff(&bytes) {
+            Some(ImageFormat::Png) => {
+                let reader = png::Decoder::new(Cursor::new(&bytes))
+                    .read_info()
+                    .map_err(|e| DataError::file(path, format!("not a readable PNG: {e}")))?;
+                (reader.info().width as usize, reader.info().height as usize)
+            }
+            Some(ImageFormat::Jpeg) => {
+                let mut decoder = JpegDecoder::new(ZCursor::new(&bytes));
+                decoder
+                    .decode_headers()
+                    .map_err(|e| DataError::file(path, format!("not a readable JPEG: {e}")))?;
+                decoder
+                    .dimensions()
+                    .ok_or_else(|| DataError::file(path, "not a readable JPEG: no frame header"))?
+            }
+            None => return Self::decode(path, &bytes).map(|i| (i.width, i.height)),
+        };
+        check_size(path, w, h)?;
+        Ok((w, h))
     }
 
     /// Reads a PNG or JPEG file (see [`Image::decode`]).
@@ -78,6 +121,7 @@ impl Image {
         let mut decoder = png::Decoder::new(BufReader::new(Cursor::new(bytes)));
         decoder.set_transformations(png::Transformations::EXPAND);
         let mut reader = decoder.read_info().map_err(err)?;
+        check_size(path, reader.info().width as usize, reader.info().height as usize)?;
         let size = reader
             .output_buffer_size()
             .ok_or_else(|| DataError::file(path, "PNG dimensions are too large"))?;
@@ -116,12 +160,15 @@ impl Image {
     fn decode_jpeg(path: &Path, bytes: &[u8]) -> Result<Self, DataError> {
         let err =
             |e: zune_jpeg::errors::DecodeErrors| DataError::file(path, format!("not a readable JPEG: {e}"));
-        let options = DecoderOptions::default().jpeg_set_out_colorspace(ColorSpace::RGB);
+        // Strict: a truncated or corrupt file is an error, not grey blocks to train on.
+        let options =
+            DecoderOptions::default().jpeg_set_out_colorspace(ColorSpace::RGB).set_strict_mode(true);
         let mut decoder = JpegDecoder::new_with_options(ZCursor::new(bytes), options);
         decoder.decode_headers().map_err(err)?;
         let (w, h) = decoder
             .dimensions()
             .ok_or_else(|| DataError::file(path, "not a readable JPEG: no frame header"))?;
+        check_size(path, w, h)?;
         let rgb = decoder.decode().map_err(err)?;
         let pixels = rgb.chunks_exact(3).map(|p| [p[0], p[1], p[2]].map(|b| b as f32 / 255.0)).collect();
         Ok(Self { width: w, height: h, pixels })

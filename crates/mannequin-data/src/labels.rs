@@ -44,6 +44,7 @@ impl LabelMap {
             ));
         }
         let (width, height) = (info.width as usize, info.height as usize);
+        crate::image_decode::check_size(path, width, height)?;
         let size = reader
             .output_buffer_size()
             .ok_or_else(|| DataError::file(path, "PNG dimensions are too large"))?;
@@ -51,6 +52,22 @@ impl LabelMap {
         reader.next_frame(&mut labels).map_err(err)?;
         labels.truncate(width * height);
         Ok(Self { width, height, labels })
+    }
+
+    /// Reads a label map whose legend names `legend` labels, refusing a pixel whose index is past
+    /// it: a label nothing names is a broken file, not a part of the person.
+    pub fn read_png_with_legend(path: &Path, legend: usize) -> Result<Self, DataError> {
+        let map = Self::read_png(path)?;
+        if let Some(i) = map.labels.iter().position(|&l| usize::from(l) >= legend) {
+            return Err(DataError::file(
+                path,
+                format!(
+                    "pixel {i} has label {}: expected an index into the legend's {legend} labels",
+                    map.labels[i]
+                ),
+            ));
+        }
+        Ok(map)
     }
 }
 
@@ -66,6 +83,9 @@ mod tests {
         let map = LabelMap { width: 3, height: 2, labels: vec![0, 1, 2, 3, 4, 255] };
         map.write_png(&path).unwrap();
         assert_eq!(LabelMap::read_png(&path).unwrap(), map);
+        let e = LabelMap::read_png_with_legend(&path, 5).unwrap_err().to_string();
+        assert!(e.contains("label_0000.png") && e.contains("pixel 5 has label 255"), "{e}");
+        assert_eq!(LabelMap::read_png_with_legend(&path, 256).unwrap(), map);
         let colour = crate::image::Image { width: 1, height: 1, pixels: vec![[0.5; 3]] };
         colour.write_png(&path).unwrap();
         let e = LabelMap::read_png(&path).unwrap_err().to_string();

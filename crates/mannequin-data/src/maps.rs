@@ -117,6 +117,15 @@ impl DepthMap {
         let depth = a
             .to_f32()
             .ok_or_else(|| DataError::file(path, format!("expected numbers, found {}", a.dtype_name())))?;
+        if let Some(i) = depth.iter().position(|d| !(d.is_finite() && *d >= 0.0)) {
+            return Err(DataError::file(
+                path,
+                format!(
+                    "pixel {i} has depth {}: expected a finite distance ≥ 0 (0 for background)",
+                    depth[i]
+                ),
+            ));
+        }
         Ok(Self { width: w, height: h, depth })
     }
 
@@ -144,6 +153,8 @@ impl DepthMap {
 }
 
 /// Reads a `(H, W)` mask `.npy`; values ≥ 0.5 are foreground, so 0/1 and 0/255 both work.
+/// Floating-point masks must lie in [0, 1] and whole-number ones in [0, 255]: anything else
+/// (a NaN, a negative) is not a mask.
 pub fn read_mask_npy(path: &Path) -> Result<Mask, DataError> {
     let bytes = std::fs::read(path).map_err(|e| DataError::os(path, e))?;
     let a = mannequin_io::npy::parse_npy(&bytes).map_err(|e| DataError::file(path, e.to_string()))?;
@@ -159,6 +170,13 @@ pub fn read_mask_npy(path: &Path) -> Result<Mask, DataError> {
     let v = a
         .to_f64()
         .ok_or_else(|| DataError::file(path, format!("expected numbers, found {}", a.dtype_name())))?;
+    let top = if matches!(a.data, NpyData::F32(_) | NpyData::F64(_)) { 1.0 } else { 255.0 };
+    if let Some(i) = v.iter().position(|x| !(0.0..=top).contains(x)) {
+        return Err(DataError::file(
+            path,
+            format!("pixel {i} is {}: expected a mask value in [0, {top}]", v[i]),
+        ));
+    }
     Ok(Mask { width: w, height: h, values: v.into_iter().map(|x| x >= 0.5).collect() })
 }
 

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use mannequin_io::limits::{MAX_BETA, MAX_DISTANCE};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::DataError;
@@ -62,21 +63,21 @@ impl Poses {
     /// Reads the arrays, also accepting `thetas (N,72)` in place of `global_orient` + `body_pose`.
     pub fn read(path: &Path) -> Result<Self, DataError> {
         let npz = Npz::read(path)?;
-        let (_, transl) = npz.f64_with_shape("transl", &[None, Some(3)])?;
+        let (_, transl) = npz.f64_in_range("transl", &[None, Some(3)], -MAX_DISTANCE..=MAX_DISTANCE)?;
         let n = transl.len() / 3;
         let betas = match npz.require("betas")?.shape.len() {
-            1 => npz.f64_with_shape("betas", &[None])?.1,
-            _ => npz.f64_with_shape("betas", &[Some(1), None])?.1,
+            1 => npz.f64_in_range("betas", &[None], -MAX_BETA..=MAX_BETA)?.1,
+            _ => npz.f64_in_range("betas", &[Some(1), None], -MAX_BETA..=MAX_BETA)?.1,
         };
         let (global_orient, body_pose) = if npz.contains("thetas") {
-            let (_, t) = npz.f64_with_shape("thetas", &[Some(n), Some(72)])?;
+            let (_, t) = npz.finite_f64_with_shape("thetas", &[Some(n), Some(72)])?;
             let go = t.chunks_exact(72).flat_map(|r| r[..3].to_vec()).collect();
             let bp = t.chunks_exact(72).flat_map(|r| r[3..].to_vec()).collect();
             (go, bp)
         } else {
             (
-                npz.f64_with_shape("global_orient", &[Some(n), Some(3)])?.1,
-                npz.f64_with_shape("body_pose", &[Some(n), Some(BODY_POSE_LEN)])?.1,
+                npz.finite_f64_with_shape("global_orient", &[Some(n), Some(3)])?.1,
+                npz.finite_f64_with_shape("body_pose", &[Some(n), Some(BODY_POSE_LEN)])?.1,
             )
         };
         Ok(Self {

@@ -21,7 +21,13 @@ impl SplitRange {
         Self { start, end, step }
     }
 
-    /// The frame numbers of the split, in order.
+    /// The split's last frame, found without listing them (a file may claim `end` 2⁶⁴ − 1).
+    pub fn last(&self) -> usize {
+        self.start + (self.end.saturating_sub(self.start) / self.step.max(1)) * self.step.max(1)
+    }
+
+    /// The frame numbers of the split, in order; check [`SplitRange::last`] against the frames
+    /// there are first.
     pub fn frames(&self) -> Vec<usize> {
         (self.start..=self.end).step_by(self.step.max(1)).collect()
     }

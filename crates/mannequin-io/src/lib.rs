@@ -1,8 +1,9 @@
 //! File plumbing shared by every Mannequin crate: NumPy arrays (in `.npy`, `.npz`, or pickled),
-//! PLY headers and values, and atomic writes.
+//! PLY headers and values, atomic writes, and the limits on what any reader accepts.
 
 pub mod atomic;
 pub mod error;
+pub mod limits;
 pub mod npy;
 pub mod npz;
 pub mod pickle;

@@ -353,10 +353,11 @@ fn read_header(bytes: &[u8]) -> Result<Header, NpyError> {
     Ok(Header { descr, fortran, shape, data_start, data_len })
 }
 
-/// Bytes the whole file takes, header and data, by its header's shape and dtype; `bytes` must
-/// hold the header ([`header_end`]). An archive reader refuses a member that inflates past this.
-pub fn declared_len(bytes: &[u8]) -> Result<usize, NpyError> {
-    read_header(bytes).map(|h| h.data_start + h.data_len)
+/// Bytes the whole file takes, header and data, and the array's shape, by its header; `bytes`
+/// must hold the header ([`header_end`]). An archive reader refuses a member that inflates past
+/// this length, and checks the shape before inflating any of it.
+pub fn declared(bytes: &[u8]) -> Result<(usize, Vec<usize>), NpyError> {
+    read_header(bytes).map(|h| (h.data_start + h.data_len, h.shape))
 }
 
 /// Parses one `.npy` file held in memory.
@@ -520,9 +521,9 @@ mod tests {
     }
 
     #[test]
-    fn declared_len_is_header_plus_data_and_long_headers_are_refused() {
+    fn declared_is_header_plus_data_and_long_headers_are_refused() {
         let b = numpy_f8_2x3();
-        assert_eq!(declared_len(&b).unwrap(), b.len());
+        assert_eq!(declared(&b).unwrap(), (b.len(), vec![2, 3]));
         assert_eq!(header_end(&b[..PREFIX_LEN]).unwrap(), b.len() - 48);
         let mut long = b"\x93NUMPY\x02\x00".to_vec();
         long.extend_from_slice(&u32::MAX.to_le_bytes());

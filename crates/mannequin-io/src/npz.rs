@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::atomic::write_atomic;
 use crate::error::{IoError, NpyError};
+use crate::limits::{MAX_ARCHIVE_ELEMENTS, MAX_ARRAY_ELEMENTS};
 use crate::npy::{self, NpyArray, NpyData, parse_npy, write_npy};
 
 /// All arrays of one `.npz` file (or of a pickled dict, see `pickle_arrays.rs`), decoded
@@ -32,17 +33,17 @@ impl Npz {
         let archive_err = |reason: String| IoError::Archive { path: path.clone(), reason };
         let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| archive_err(e.to_string()))?;
         let mut arrays = BTreeMap::new();
+        let mut elements = 0usize;
         for i in 0..zip.len() {
             let entry = zip.by_index(i).map_err(|e| archive_err(e.to_string()))?;
             let name = entry.name().to_string();
             let key = name.strip_suffix(".npy").unwrap_or(&name).to_string();
-            let array =
-                read_member(entry, bytes.len()).and_then(|member| Ok(parse_npy(&member)?)).map_err(|e| {
-                    match e {
-                        MemberError::Inflate(e) => archive_err(format!("member '{name}': {e}")),
-                        MemberError::Npy(e) => {
-                            IoError::Field { path: path.clone(), key: key.clone(), reason: e.to_string() }
-                        }
+            let array = read_member(entry, bytes.len(), &mut elements)
+                .and_then(|member| Ok(parse_npy(&member)?))
+                .map_err(|e| match e {
+                    MemberError::Inflate(e) => archive_err(format!("member '{name}': {e}")),
+                    MemberError::Npy(e) => {
+                        IoError::Field { path: path.clone(), key: key.clone(), reason: e.to_string() }
                     }
                 })?;
             arrays.insert(key, array);
@@ -115,6 +116,39 @@ impl Npz {
         })?;
         Ok((a.shape.clone(), v))
     }
+
+    /// [`Npz::f64_with_shape`], refusing a NaN or infinity by its index: a reader hands on
+    /// only numbers that mean something.
+    pub fn finite_f64_with_shape(
+        &self,
+        key: &str,
+        expected: &[Option<usize>],
+    ) -> Result<(Vec<usize>, Vec<f64>), IoError> {
+        let (shape, v) = self.f64_with_shape(key, expected)?;
+        match v.iter().position(|x| !x.is_finite()) {
+            Some(i) => {
+                Err(self.field_error(key, format!("element {i} is {}: expected a finite number", v[i])))
+            }
+            None => Ok((shape, v)),
+        }
+    }
+
+    /// The array under `key` as finite f64 in `range`, refusing the first value outside it.
+    pub fn f64_in_range(
+        &self,
+        key: &str,
+        expected: &[Option<usize>],
+        range: std::ops::RangeInclusive<f64>,
+    ) -> Result<(Vec<usize>, Vec<f64>), IoError> {
+        let (shape, v) = self.finite_f64_with_shape(key, expected)?;
+        match v.iter().position(|x| !range.contains(x)) {
+            Some(i) => Err(self.field_error(
+                key,
+                format!("element {i} is {}: expected {}–{}", v[i], range.start(), range.end()),
+            )),
+            None => Ok((shape, v)),
+        }
+    }
 }
 
 /// Why a member could not be read: its compressed bytes, or its array's header.
@@ -137,15 +171,34 @@ impl From<NpyError> for MemberError {
 
 /// Inflates one member no further than its `.npy` header declares (header plus shape × dtype
 /// bytes), so a zip bomb costs only what its header admits to: the header is read first, then
-/// at most the declared length and one byte more, which is refused. Nothing is reserved by the
-/// archive's own size fields, and never more than the archive's length (all a stored member
-/// needs).
-fn read_member(mut entry: impl Read, archive_len: usize) -> Result<Vec<u8>, MemberError> {
+/// at most the declared length and one byte more, which is refused. The header's shape is held
+/// to [`MAX_ARRAY_ELEMENTS`], and `elements` (the archive's running total) to
+/// [`MAX_ARCHIVE_ELEMENTS`], before anything is inflated: a few kilobytes of deflated zeros may
+/// honestly hold gigabytes. Nothing is reserved by the archive's own size fields, and never more
+/// than the archive's length (all a stored member needs).
+fn read_member(
+    mut entry: impl Read,
+    archive_len: usize,
+    elements: &mut usize,
+) -> Result<Vec<u8>, MemberError> {
     let mut buf = Vec::new();
     (&mut entry).take(npy::PREFIX_LEN as u64).read_to_end(&mut buf)?;
     let header_end = npy::header_end(&buf)?;
     (&mut entry).take(header_end.saturating_sub(buf.len()) as u64).read_to_end(&mut buf)?;
-    let declared = npy::declared_len(&buf)?;
+    let (declared, shape) = npy::declared(&buf)?;
+    let count: usize = shape.iter().product();
+    if count > MAX_ARRAY_ELEMENTS {
+        return Err(MemberError::Npy(NpyError::Format(format!(
+            "shape {shape:?} holds {count} elements, expected at most {MAX_ARRAY_ELEMENTS}"
+        ))));
+    }
+    *elements += count;
+    if *elements > MAX_ARCHIVE_ELEMENTS {
+        return Err(MemberError::Npy(NpyError::Format(format!(
+            "shape {shape:?} brings the archive to {} elements, expected at most {MAX_ARCHIVE_ELEMENTS} in all",
+            *elements
+        ))));
+    }
     buf.reserve(declared.min(archive_len).saturating_sub(buf.len()));
     (&mut entry).take((declared.saturating_sub(buf.len()) as u64).saturating_add(1)).read_to_end(&mut buf)?;
     if buf.len() > declared {
@@ -296,5 +349,67 @@ mod tests {
             err.starts_with("bomb.npz: ") && err.contains("'x.npy'") && err.contains("inflates past"),
             "{err}"
         );
+    }
+
+    /// A zip member of `npy` bytes.
+    fn zipped(members: &[(&str, Vec<u8>)]) -> Vec<u8> {
+        let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+        for (name, bytes) in members {
+            zip.start_file(*name, zip::write::SimpleFileOptions::default()).unwrap();
+            zip.write_all(bytes).unwrap();
+        }
+        zip.finish().unwrap().into_inner()
+    }
+
+    /// The header of a `|u1` array of `n` elements, with no data.
+    fn u8_header(n: usize) -> Vec<u8> {
+        let mut h = format!("{{'descr': '|u1', 'fortran_order': False, 'shape': ({n},), }}");
+        h.push_str(&" ".repeat((64 - (10 + h.len() + 1) % 64) % 64));
+        h.push('\n');
+        let mut out = b"\x93NUMPY\x01\x00".to_vec();
+        out.extend_from_slice(&(h.len() as u16).to_le_bytes());
+        out.extend_from_slice(h.as_bytes());
+        out
+    }
+
+    /// A header claiming 200 million rows is refused by its shape, before any of it is inflated
+    /// (issue 42: a 2.5 MB garment once took 9.4 GB this way), and so is an archive whose arrays
+    /// add up past the archive limit.
+    #[test]
+    fn shapes_past_the_limits_are_refused_before_inflating() {
+        let bytes = zipped(&[("positions.npy", u8_header(600_000_000))]);
+        let err = Npz::from_bytes("g.garment".into(), &bytes).unwrap_err().to_string();
+        assert!(
+            err.contains("g.garment")
+                && err.contains("'positions'")
+                && err.contains(&MAX_ARRAY_ELEMENTS.to_string()),
+            "{err}"
+        );
+        let big = write_npy(&NpyArray {
+            shape: vec![MAX_ARRAY_ELEMENTS],
+            data: NpyData::U8(vec![0; MAX_ARRAY_ELEMENTS]),
+        });
+        assert_eq!(MAX_ARCHIVE_ELEMENTS, 2 * MAX_ARRAY_ELEMENTS);
+        let bytes = zipped(&[("a.npy", big.clone()), ("b.npy", big), ("c.npy", u8_header(1))]);
+        let err = Npz::from_bytes("m.npz".into(), &bytes).unwrap_err().to_string();
+        assert!(err.contains("'c'") && err.contains("in all"), "{err}");
+        let ok = zipped(&[("a.npy", write_npy(&NpyArray::f32(vec![2], vec![1.0, 2.0])))]);
+        assert!(Npz::from_bytes("m.npz".into(), &ok).is_ok());
+    }
+
+    #[test]
+    fn non_finite_and_out_of_range_values_are_named_by_index() {
+        let mut w = NpzWriter::new();
+        w.add("betas", NpyArray::f64(vec![3], vec![0.5, f64::NAN, 1.0]));
+        w.add("transl", NpyArray::f64(vec![2], vec![0.5, 2e6]));
+        let npz = Npz::from_bytes("p.npz".into(), &w.to_bytes()).unwrap();
+        let e = npz.finite_f64_with_shape("betas", &[None]).unwrap_err().to_string();
+        assert!(e.contains("p.npz") && e.contains("'betas'") && e.contains("element 1 is NaN"), "{e}");
+        let e = npz.f64_in_range("transl", &[None], -1e3..=1e3).unwrap_err().to_string();
+        assert!(
+            e.contains("'transl'") && e.contains("element 1 is 2000000") && e.contains("-1000–1000"),
+            "{e}"
+        );
+        assert!(npz.f64_in_range("transl", &[None], -1e7..=1e7).is_ok());
     }
 }

@@ -4,6 +4,10 @@
 
 use glam::{DMat3, DVec3};
 
+use mannequin_io::limits::{
+    FOCAL_RANGE_PER_SIDE, MAX_DISTANCE, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_PRINCIPAL_OFFSET_SIDES,
+};
+
 use crate::SplatError;
 use crate::real::Real;
 
@@ -21,9 +25,6 @@ pub struct Camera {
     pub near: f64,
     pub far: f64,
 }
-
-/// Largest accepted image side; beyond this tile indices and buffers would overflow.
-const MAX_SIDE: usize = 1 << 15;
 
 impl Camera {
     /// A camera from its matrices, clipping at near 0.01 and far 1e10: nothing a human-scale
@@ -131,9 +132,9 @@ impl Camera {
         if self.width == 0 || self.height == 0 {
             return err(format!("image size {}×{} is empty", self.width, self.height));
         }
-        if self.width > MAX_SIDE || self.height > MAX_SIDE {
+        if self.width.max(self.height) > MAX_IMAGE_SIDE || self.width * self.height > MAX_IMAGE_PIXELS {
             return err(format!(
-                "image size {}×{} exceeds {MAX_SIDE} pixels a side",
+                "image size {}×{}: expected at most {MAX_IMAGE_SIDE} a side and {MAX_IMAGE_PIXELS} pixels",
                 self.width, self.height
             ));
         }
@@ -149,6 +150,25 @@ impl Camera {
         }
         if k[0][1] != 0.0 || k[1][0] != 0.0 || k[2] != [0.0, 0.0, 1.0] {
             return err(format!("intrinsic K must be [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], found {k:?}"));
+        }
+        let side = self.width.max(self.height) as f64;
+        let (lo, hi) = FOCAL_RANGE_PER_SIDE;
+        if [k[0][0], k[1][1]].iter().any(|&f| f < lo * side || f > hi * side) {
+            return err(format!(
+                "intrinsic K's focal lengths fx={} fy={}: expected {lo}–{hi} times the image's longer side ({side} px)",
+                k[0][0], k[1][1]
+            ));
+        }
+        let reach = MAX_PRINCIPAL_OFFSET_SIDES * side;
+        if k[0][2] < -reach
+            || k[0][2] > self.width as f64 + reach
+            || k[1][2] < -reach
+            || k[1][2] > self.height as f64 + reach
+        {
+            return err(format!(
+                "intrinsic K's principal point ({}, {}): expected within {MAX_PRINCIPAL_OFFSET_SIDES} image sides of the image",
+                k[0][2], k[1][2]
+            ));
         }
         let e = &self.extrinsic;
         if e.iter().flatten().any(|v| !v.is_finite()) {
@@ -173,6 +193,12 @@ impl Camera {
             + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
         if det < 0.0 {
             return err("extrinsic rotation is a reflection (det = -1)".into());
+        }
+        let t = [e[0][3], e[1][3], e[2][3]];
+        if t.iter().map(|v| v * v).sum::<f64>().sqrt() > MAX_DISTANCE {
+            return err(format!(
+                "extrinsic translation {t:?}: expected within {MAX_DISTANCE} m of the origin"
+            ));
         }
         if !(self.near > 0.0 && self.near.is_finite() && self.far > self.near) {
             return err(format!("need 0 < near < far, found near={} far={}", self.near, self.far));
@@ -316,5 +342,28 @@ mod tests {
         let mut c = good();
         c.intrinsic[0][1] = 1.0;
         assert!(c.validate().unwrap_err().to_string().contains("must be"));
+    }
+
+    /// Values a file may hold but no capture has (issue 42): fx = 1e300 once put the body
+    /// 1.5e27 m away, and a 32768² camera asked `render` for 25.8 GB.
+    #[test]
+    fn cameras_out_of_any_capture_are_rejected_with_the_limit() {
+        let mut c = good();
+        c.intrinsic[0][0] = 1e300;
+        assert!(c.validate().unwrap_err().to_string().contains("times the image's longer side"));
+        let mut c = good();
+        c.intrinsic[1][1] = 1e-3;
+        assert!(c.validate().unwrap_err().to_string().contains("times the image's longer side"));
+        let mut c = good();
+        c.intrinsic[0][2] = -1e9;
+        assert!(c.validate().unwrap_err().to_string().contains("principal point"));
+        let mut c = good();
+        c.extrinsic[2][3] = 1e6;
+        assert!(c.validate().unwrap_err().to_string().contains("of the origin"));
+        let mut c = good();
+        (c.width, c.height) = (32768, 32768);
+        c.intrinsic = [[20000.0, 0.0, 16384.0], [0.0, 20000.0, 16384.0], [0.0, 0.0, 1.0]];
+        assert!(c.validate().unwrap_err().to_string().contains("at most"));
+        good().validate().unwrap();
     }
 }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use mannequin_body::{BodyModel, FaceModel, forward, skeletal_animation, skinned_body};
+use mannequin_io::limits::MAX_BETA;
 use mannequin_mesh::TriMesh;
 use serde_json::json;
 
@@ -28,9 +29,20 @@ pub struct BodyArgs {
     /// Body model: `default`, `default-lod1`, or a SMPL / SMPL-H / SMPL-X `.npz` or released `.pkl`.
     #[arg(long, default_value = "default")]
     pub body: String,
-    /// Shape coefficients, comma-separated (missing ones are 0).
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    /// Shape coefficients, comma-separated (missing ones are 0), each within ±10.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = parse_beta)]
     pub betas: Vec<f32>,
+}
+
+/// One shape coefficient: finite and within [`MAX_BETA`] standard deviations, refused at parse
+/// time (`--betas 1e6` once grew a garment to 5 GB).
+fn parse_beta(text: &str) -> Result<f32, String> {
+    let b: f32 = text.parse().map_err(|e| format!("{e}"))?;
+    if f64::from(b.abs()) <= MAX_BETA {
+        Ok(b)
+    } else {
+        Err(format!("{b}: expected a finite shape coefficient within ±{MAX_BETA}"))
+    }
 }
 
 #[derive(Args)]

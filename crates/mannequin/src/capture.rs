@@ -63,7 +63,20 @@ struct CaptureRun {
     focal: Option<f64>,
 }
 
+/// Captures, and where the run fails before its first checkpoint, removes the output folder it
+/// made: nothing half-made is left to mistake for a dataset. A run with a checkpoint keeps its
+/// folder, so that running it again resumes.
 pub fn run(args: Args) -> Result<()> {
+    let fresh = !args.out.exists();
+    let out = args.out.clone();
+    let result = capture(args);
+    if result.is_err() && fresh && !out.join(CHECKPOINT).exists() {
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    result
+}
+
+fn capture(args: Args) -> Result<()> {
     let _timer = JobTimer::start("capture");
     let start = Instant::now();
     args.fitting.check()?;
@@ -71,6 +84,7 @@ pub fn run(args: Args) -> Result<()> {
     if files.len() < 2 {
         bail!("{}: {} frame(s); a capture needs at least 2", dir.display(), files.len());
     }
+    same_size(&files)?;
     let run = CaptureRun {
         source: args.input.source(&files)?,
         fps: args.input.fps,
@@ -97,7 +111,7 @@ pub fn run(args: Args) -> Result<()> {
     let models = PersonModels::load()?;
     track(&models, &files, &args.out, &checkpoint, &run, &mut saved)?;
     let (width, height) = (saved.kept[0].1.width, saved.kept[0].1.height);
-    let focal = args.fitting.focal(width, height);
+    let focal = args.fitting.focal(width, height)?;
     let fitter = Fitter::new(&model, width, height, focal)?;
     // The fit reads the landmarks with the mirrors undone; the checkpoint keeps them as read.
     let mut people_read = saved.people.clone();
@@ -130,6 +144,26 @@ pub fn run(args: Args) -> Result<()> {
         skipped.len(),
         args.out.display()
     );
+    Ok(())
+}
+
+/// Refuses a clip whose frames differ in size, from their headers, before any work.
+fn same_size(files: &[PathBuf]) -> Result<()> {
+    let first = Image::read_size(&files[0])?;
+    for file in &files[1..] {
+        let size = Image::read_size(file)?;
+        if size != first {
+            bail!(
+                "{}: {}×{}, but the clip's first frame ({}) is {}×{}",
+                file.display(),
+                size.0,
+                size.1,
+                files[0].display(),
+                first.0,
+                first.1
+            );
+        }
+    }
     Ok(())
 }
 
@@ -170,18 +204,6 @@ fn track(
     let mut tracker = Tracker::resume(models, followed);
     for (i, file) in files.iter().enumerate().skip(saved.tracked) {
         let image = Image::read(file)?;
-        if let Some((_, first)) = saved.kept.first()
-            && (image.width, image.height) != (first.width, first.height)
-        {
-            bail!(
-                "{}: {}×{}, but the clip's frames are {}×{}",
-                file.display(),
-                image.width,
-                image.height,
-                first.width,
-                first.height
-            );
-        }
         match tracker.next(&image).with_context(|| file.display().to_string())? {
             Some(l) => {
                 let mask = l.person_mask(image.width, image.height);

@@ -72,7 +72,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
             args.image.display()
         );
     }
-    let focal = args.fitting.focal(image.width, image.height);
+    let focal = args.fitting.focal(image.width, image.height)?;
     let (body, face_model) = (BodyModel::default_body(), FaceModel::default_face());
     let fitter = FaceFitter::new(&body, &face_model, image.width, image.height, focal)?;
     let fitted = fitter

@@ -99,7 +99,7 @@ fn track_frames(args: &FaceTrackArgs, frames: &Frames, start: Instant) -> Result
     let first = Image::read(&files[0])?;
     let (width, height) = (first.width, first.height);
     let (body, face) = (BodyModel::default_body(), FaceModel::default_face());
-    let fitter = FaceFitter::new(&body, &face, width, height, args.fitting.focal(width, height))?;
+    let fitter = FaceFitter::new(&body, &face, width, height, args.fitting.focal(width, height)?)?;
     let mut done = match !args.restart && checkpoint.exists() {
         true => {
             let done = read_checkpoint(&checkpoint, &run, &fitter)?;

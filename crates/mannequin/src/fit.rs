@@ -13,6 +13,7 @@ use mannequin_data::Image;
 use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
 use mannequin_fit::FaceModels;
 use mannequin_fit::body_fit::assumed_focal;
+use mannequin_io::limits::FOCAL_RANGE_PER_SIDE;
 use mannequin_fit::face_fit::{FaceFit, FaceFitter};
 use mannequin_fit::overlay::overlay;
 use mannequin_fit::pose_landmarker::PoseLandmarks;
@@ -65,9 +66,21 @@ impl FitArgs {
         Ok(())
     }
 
-    /// The focal length for pictures of `width` × `height` pixels.
-    pub fn focal(&self, width: usize, height: usize) -> f64 {
-        self.focal.unwrap_or_else(|| assumed_focal(width, height))
+    /// The focal length for pictures of `width` × `height` pixels, within
+    /// [`FOCAL_RANGE_PER_SIDE`] of their longer side (`--focal 1e30` once put the body 1.5e27 m
+    /// away).
+    pub fn focal(&self, width: usize, height: usize) -> Result<f64> {
+        let Some(f) = self.focal else { return Ok(assumed_focal(width, height)) };
+        let side = width.max(height) as f64;
+        let (lo, hi) = FOCAL_RANGE_PER_SIDE;
+        if f < lo * side || f > hi * side {
+            bail!(
+                "--focal: {f} pixels for a {width}×{height} picture: expected {lo}–{hi} times its longer side ({}–{} px)",
+                lo * side,
+                hi * side
+            );
+        }
+        Ok(f)
     }
 }
 
@@ -88,7 +101,7 @@ pub fn run(args: Args) -> Result<()> {
     let people = models.people(&image)?;
     let person = pick_person(&people, args.person).with_context(|| args.image.display().to_string())?;
     let landmarks = models.refine(&image, person.landmarks.clone())?;
-    let focal = args.fitting.focal(image.width, image.height);
+    let focal = args.fitting.focal(image.width, image.height)?;
     let fit = fit_body(&model, &landmarks, image.width, image.height, focal)
         .with_context(|| format!("fitting the body to {}", args.image.display()))?;
     let face_model = (!args.no_face && args.fitting.body == "default").then(FaceModel::default_face);

@@ -158,7 +158,7 @@ pub fn reconstruct(
         .enumerate()
         .map(|(k, &f)| {
             let camera = dataset.camera(f).clone();
-            let target = Target::read(data, &camera, f, label, &outer)?;
+            let target = Target::read(data, &camera, f, label, legend.len(), &outer)?;
             Ok(TrainingFrame { target, camera, pose: frame_pose(&train, k) })
         })
         .collect::<Result<Vec<_>>>()?;

@@ -25,16 +25,18 @@ pub struct Target {
 impl Target {
     /// Frame `frame` of the dataset at `root`, at the resolution of `camera` (the label map's size
     /// divided by a whole factor). Pixels of the labels `outer` (garments worn over this one,
-    /// which may hide it) do not count, as hands do not.
+    /// which may hide it) do not count, as hands do not. Every label must be one of the `legend`
+    /// the dataset names.
     pub fn read(
         root: &Path,
         camera: &Camera,
         frame: usize,
         label: u8,
+        legend: usize,
         outer: &[u8],
     ) -> Result<Self, GarmentError> {
         let path = layout::label(root, frame);
-        let labels = LabelMap::read_png(&path)?;
+        let labels = LabelMap::read_png_with_legend(&path, legend)?;
         let factor = labels.width / camera.width.max(1);
         if factor == 0 || labels.width != factor * camera.width || labels.height != factor * camera.height {
             return Err(GarmentError::File {
@@ -45,7 +47,9 @@ impl Target {
                 ),
             });
         }
-        let hands = read_mask_npy(&layout::hand_mask(root, frame)).ok();
+        // Hand masks are optional, but one that is there must read.
+        let hand_path = layout::hand_mask(root, frame);
+        let hands = if hand_path.exists() { Some(read_mask_npy(&hand_path)?) } else { None };
         let (w, h) = (camera.width, camera.height);
         let mut mask = vec![0.0; w * h];
         let mut counts = vec![true; w * h];

@@ -6,12 +6,14 @@ mod blend_shapes;
 mod buffer;
 mod document;
 mod glb;
+mod glb_check;
 pub mod influences;
 mod model;
 mod morph;
 mod split;
 
 pub use blend_shapes::{BlendShapeAnimation, BlendShapeMesh, write_blend_shape_glb};
+pub use glb_check::check_glb;
 pub use document::{scene_glb_bytes, write_glb, write_layered_glb, write_scene_glb};
 pub use model::{SkeletalAnimation, Skeleton, SkinnedLayer, SkinnedMesh};
 pub use morph::MorphSequence;

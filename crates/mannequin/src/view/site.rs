@@ -9,7 +9,8 @@ use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
 use mannequin_avatar::{AVATAR_DILATION, Avatar, export};
 use mannequin_body::Motion;
-use mannequin_mesh::gltf::scene_glb_bytes;
+use mannequin_io::PlyHeader;
+use mannequin_mesh::gltf::{check_glb, scene_glb_bytes};
 use mannequin_splat::SplatScene;
 use serde_json::{Value, json};
 
@@ -187,6 +188,9 @@ impl Site {
         };
         let first_glb = layers.len();
         for p in files.iter().filter(|p| extension(p).as_deref() == Some("glb")) {
+            // Served only once it parses: a broken file is refused here, not in the browser.
+            let bytes = std::fs::read(p).with_context(|| format!("reading {}", p.display()))?;
+            check_glb(p, &bytes)?;
             layers.push(Layer {
                 name: stem(p),
                 url: url(p)?,
@@ -199,6 +203,7 @@ impl Site {
         let skeleton = layers.get(first_glb).filter(|l| l.kind == "glb").map(|l| l.name.clone());
         for p in files.iter().filter(|p| extension(p).as_deref() == Some("ply")) {
             let bytes = std::fs::read(p).with_context(|| format!("reading {}", p.display()))?;
+            PlyHeader::parse(&bytes).with_context(|| format!("{}: not a readable PLY", p.display()))?;
             if SplatScene::from_ply_bytes(p, &bytes).is_err() {
                 tracing::info!("{}: not 3DGS splats (no f_dc/scale/rot properties); not shown", p.display());
                 continue;
