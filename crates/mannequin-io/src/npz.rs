@@ -263,8 +263,24 @@ impl NpzWriter {
         zip.finish().expect("in-memory zip finish").into_inner()
     }
 
+    /// Writes the archive atomically, refusing a NaN or an infinity in any float array: a file
+    /// that holds one would be refused by every reader, so it is not written.
     pub fn write(&self, path: impl AsRef<Path>) -> Result<(), IoError> {
         let path = path.as_ref();
+        for (key, array) in &self.arrays {
+            let bad = match &array.data {
+                NpyData::F32(v) => v.iter().position(|x| !x.is_finite()).map(|i| (i, f64::from(v[i]))),
+                NpyData::F64(v) => v.iter().position(|x| !x.is_finite()).map(|i| (i, v[i])),
+                _ => None,
+            };
+            if let Some((i, x)) = bad {
+                return Err(IoError::Field {
+                    path: path.to_path_buf(),
+                    key: key.clone(),
+                    reason: format!("element {i} is {x}: refusing to write a non-finite number"),
+                });
+            }
+        }
         write_atomic(path, &self.to_bytes())
             .map_err(|source| IoError::Io { path: path.to_path_buf(), source })
     }
@@ -411,5 +427,19 @@ mod tests {
             "{e}"
         );
         assert!(npz.f64_in_range("transl", &[None], -1e7..=1e7).is_ok());
+    }
+
+    #[test]
+    fn a_non_finite_number_is_not_written() {
+        let dir = std::env::temp_dir().join(format!("mq-npz-nan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.npz");
+        let mut w = NpzWriter::new();
+        w.add("ok", NpyArray::f64(vec![1], vec![1.0]))
+            .add("x", NpyArray::f32(vec![3], vec![0.0, 1.0, f32::NAN]));
+        let e = w.write(&path).unwrap_err().to_string();
+        assert!(e.contains("out.npz") && e.contains("'x'") && e.contains("element 2 is NaN"), "{e}");
+        assert!(!path.exists());
+        std::fs::remove_dir_all(dir).unwrap();
     }
 }
