@@ -186,7 +186,7 @@ fn read_member(
     let header_end = npy::header_end(&buf)?;
     (&mut entry).take(header_end.saturating_sub(buf.len()) as u64).read_to_end(&mut buf)?;
     let (declared, shape) = npy::declared(&buf)?;
-    let count: usize = shape.iter().product();
+    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).unwrap_or(usize::MAX);
     if count > MAX_ARRAY_ELEMENTS {
         return Err(MemberError::Npy(NpyError::Format(format!(
             "shape {shape:?} holds {count} elements, expected at most {MAX_ARRAY_ELEMENTS}"
@@ -377,15 +377,9 @@ mod tests {
         zip.finish().unwrap().into_inner()
     }
 
-    /// The header of a `|u1` array of `n` elements, with no data.
+    /// The header of a `|u1` array of `n` elements, with no data after it.
     fn u8_header(n: usize) -> Vec<u8> {
-        let mut h = format!("{{'descr': '|u1', 'fortran_order': False, 'shape': ({n},), }}");
-        h.push_str(&" ".repeat((64 - (10 + h.len() + 1) % 64) % 64));
-        h.push('\n');
-        let mut out = b"\x93NUMPY\x01\x00".to_vec();
-        out.extend_from_slice(&(h.len() as u16).to_le_bytes());
-        out.extend_from_slice(h.as_bytes());
-        out
+        write_npy(&NpyArray { shape: vec![n], data: NpyData::U8(vec![]) })
     }
 
     /// A header claiming 200 million rows is refused by its shape, before any of it is inflated
