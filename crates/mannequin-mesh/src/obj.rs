@@ -309,4 +309,30 @@ mod tests {
         assert!(write_obj(&path, &mesh).unwrap_err().to_string().contains("vertex 4"));
         std::fs::remove_dir_all(dir).unwrap();
     }
+
+    #[test]
+    fn non_finite_numbers_are_not_written() {
+        let dir = std::env::temp_dir().join(format!("mq-obj-nan-{}", std::process::id()));
+        let path = dir.join("nan.obj");
+        let base = || {
+            let mut m = TriMesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]]);
+            m.colors = Some(vec![[0.5; 3]; 3]);
+            m.uv = Some(UvLayout { coords: vec![[0.0, 0.0]; 3], faces: vec![[0, 1, 2]] });
+            m
+        };
+        type Spoil = fn(&mut TriMesh);
+        let spoil: [(&str, Spoil); 3] = [
+            ("vertex 1 is not finite", |m| m.positions[1][2] = f32::INFINITY),
+            ("the colour of vertex 2 is not finite", |m| m.colors.as_mut().unwrap()[2][0] = f32::NAN),
+            ("UV coordinate 0 is not finite", |m| m.uv.as_mut().unwrap().coords[0][1] = f32::NAN),
+        ];
+        for (expected, f) in spoil {
+            let mut m = base();
+            f(&mut m);
+            let e = write_obj(&path, &m).unwrap_err().to_string();
+            assert_eq!(e, format!("{}: {expected}", path.display()));
+            assert!(!path.exists());
+        }
+        let _ = std::fs::remove_dir_all(dir);
+    }
 }

@@ -29,6 +29,23 @@ impl PointCache {
             let expected = format!("{vertices} vertices (as frame 0), found {}", self.frames[f].len());
             return Err(MeshFileError::format(path, format!("frame {f}"), expected));
         }
+        if !(self.start.is_finite() && self.sampling.is_finite() && self.sampling > 0.0) {
+            let found = format!("found start {} and sampling {}", self.start, self.sampling);
+            return Err(MeshFileError::format(
+                path,
+                "header",
+                format!("a finite start and a positive sampling, {found}"),
+            ));
+        }
+        for (f, frame) in self.frames.iter().enumerate() {
+            if let Some(v) = frame.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                return Err(MeshFileError::format(
+                    path,
+                    format!("frame {f}, vertex {v}"),
+                    "finite coordinates",
+                ));
+            }
+        }
         let count = |n: usize, what: &str| {
             i32::try_from(n)
                 .map_err(|_| MeshFileError::format(path, what, "at most 2³¹ − 1 (PC2 stores an int32)"))
@@ -119,5 +136,22 @@ mod tests {
         let e = PointCache::read(&path).unwrap_err().to_string();
         assert!(e.contains("at least one vertex"), "{e}");
         std::fs::remove_file(&path).unwrap();
+    }
+
+    #[test]
+    fn non_finite_numbers_are_not_written() {
+        let path = std::env::temp_dir().join(format!("mq-pc2-nan-{}.pc2", std::process::id()));
+        let mut cache = PointCache { start: 0.0, sampling: 1.0, frames: vec![vec![[0.0; 3]; 2]; 3] };
+        cache.frames[2][1][0] = f32::NAN;
+        let e = cache.write(&path).unwrap_err().to_string();
+        assert_eq!(e, format!("{}: frame 2, vertex 1: finite coordinates", path.display()));
+        cache.frames[2][1][0] = 0.0;
+        cache.sampling = f32::INFINITY;
+        let e = cache.write(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("header: a finite start and a positive sampling, found start 0 and sampling inf"),
+            "{e}"
+        );
+        assert!(!path.exists());
     }
 }

@@ -231,6 +231,9 @@ pub fn write(
         let expected = format!("one normal per vertex ({}), given {}", mesh.positions.len(), n.len());
         return Err(MeshFileError::format(path, "normals", expected));
     }
+    if let Some(v) = normals.and_then(|n| n.iter().position(|n| n.iter().any(|c| !c.is_finite()))) {
+        return Err(MeshFileError::format(path, format!("normal of vertex {v}"), "a finite normal"));
+    }
     let bytes = to_bytes(mesh, normals);
     mannequin_io::write_atomic(path, &bytes).map_err(|e| MeshFileError::io(path, e))
 }
@@ -301,6 +304,22 @@ mod tests {
         assert!(err.contains("idx.ply") && err.contains("vertex 9"), "{err}");
         let err = parse(Path::new("x.ply"), b"plx\n").unwrap_err().to_string();
         assert!(err.contains("magic"), "{err}");
+    }
+
+    #[test]
+    fn non_finite_numbers_are_not_written() {
+        let dir = std::env::temp_dir().join(format!("mq-ply-nan-{}", std::process::id()));
+        let path = dir.join("nan.ply");
+        let mut m = quad();
+        m.colors.as_mut().unwrap()[3][1] = f32::NAN;
+        let e = write(&path, &m, None).unwrap_err().to_string();
+        assert_eq!(e, format!("{}: the colour of vertex 3 is not finite", path.display()));
+        let mut n = vec![[0.0, 0.0, 1.0]; 4];
+        n[2][0] = f32::NEG_INFINITY;
+        let e = write(&path, &quad(), Some(&n)).unwrap_err().to_string();
+        assert_eq!(e, format!("{}: normal of vertex 2: a finite normal", path.display()));
+        assert!(!path.exists());
+        let _ = std::fs::remove_dir_all(dir);
     }
 
     /// An element of no properties takes no bytes a record, so its count is checked against the

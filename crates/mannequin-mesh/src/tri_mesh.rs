@@ -33,6 +33,10 @@ pub enum MeshError {
     ColorCount { count: usize, vertices: usize },
     #[error("vertex {vertex} is not finite")]
     NonFinite { vertex: usize },
+    #[error("the colour of vertex {vertex} is not finite")]
+    NonFiniteColor { vertex: usize },
+    #[error("UV coordinate {coord} is not finite")]
+    NonFiniteUv { coord: usize },
     #[error("vertex {pinned} pinned, but the mesh has {count} vertices")]
     PinnedVertex { pinned: usize, count: usize },
     #[error(
@@ -77,7 +81,7 @@ impl TriMesh {
         (mesh, kept_vertices)
     }
 
-    /// Checks that every index is in range and every position is finite.
+    /// Checks that every index is in range and every position, UV and colour is finite.
     pub fn validate(&self) -> Result<(), MeshError> {
         let n = self.positions.len();
         for (face, tri) in self.faces.iter().enumerate() {
@@ -98,11 +102,17 @@ impl TriMesh {
                     return Err(MeshError::UvIndex { face, index, count: m });
                 }
             }
+            if let Some(coord) = uv.coords.iter().position(|t| t.iter().any(|c| !c.is_finite())) {
+                return Err(MeshError::NonFiniteUv { coord });
+            }
         }
-        if let Some(c) = &self.colors
-            && c.len() != n
-        {
-            return Err(MeshError::ColorCount { count: c.len(), vertices: n });
+        if let Some(c) = &self.colors {
+            if c.len() != n {
+                return Err(MeshError::ColorCount { count: c.len(), vertices: n });
+            }
+            if let Some(vertex) = c.iter().position(|rgb| rgb.iter().any(|x| !x.is_finite())) {
+                return Err(MeshError::NonFiniteColor { vertex });
+            }
         }
         Ok(())
     }

@@ -450,9 +450,43 @@ fn layers_are_skinned_nodes_of_their_own() {
     if let Some(report) = report {
         assert!(report.contains(" 0 errors, 0 warnings"), "{report}");
     }
-    let bad = SkinnedLayer { weights: arm.weights[..59].to_vec(), ..layer };
+    let bad = SkinnedLayer { weights: arm.weights[..59].to_vec(), ..layer.clone() };
     let e = write_layered_glb(&path, &arm, &[bad], None).unwrap_err().to_string();
     assert!(e.contains("layer sleeve weights") && e.contains("60 values"), "{e}");
+    let mut bad = layer.clone();
+    bad.mesh.positions[3][1] = f32::NAN;
+    let e = write_layered_glb(&path, &arm, &[bad], None).unwrap_err().to_string();
+    assert!(e.ends_with("layered.glb: layer sleeve: vertex 3 is not finite"), "{e}");
+    let mut bad = layer;
+    bad.weights[7] = f32::INFINITY;
+    let e = write_layered_glb(&path, &arm, &[bad], None).unwrap_err().to_string();
+    assert!(
+        e.contains("layer sleeve weights[vertex 2, joint 1]: a finite non-negative weight, found inf"),
+        "{e}"
+    );
+    assert!(!path.exists(), "nothing is written on error");
+}
+
+/// Inputs that pass every check can still compute to a non-finite number (a root translation
+/// added to its bind position, key times of a vanishing frame rate): the file is refused naming the value's
+/// place rather than written with it.
+#[test]
+fn computed_values_that_overflow_are_not_written() {
+    let path = temp_file("overflow.glb");
+    let mut arm = arm();
+    arm.mesh.colors.as_mut().unwrap()[5][2] = f32::NAN;
+    let e = write_glb(&path, &arm, None).unwrap_err().to_string();
+    assert!(e.ends_with("overflow.glb: the colour of vertex 5 is not finite"), "{e}");
+    let mut far = motion();
+    far.root_translation[1][0] = 3e38;
+    let mut arm = self::arm();
+    arm.skeleton.bind_joints.iter_mut().for_each(|j| j[0] += 3e38);
+    let e = write_glb(&path, &arm, Some(&far)).unwrap_err().to_string();
+    assert!(e.contains("overflow.glb: animation sampler 3 output, element 1: finite numbers"), "{e}");
+    let mut slow = motion();
+    slow.fps = 1e-44;
+    let e = write_glb(&path, &self::arm(), Some(&slow)).unwrap_err().to_string();
+    assert!(e.contains("overflow.glb: animation sampler 0 input, element 1: finite numbers"), "{e}");
     assert!(!path.exists(), "nothing is written on error");
 }
 

@@ -165,7 +165,8 @@ impl SplatScene {
     /// not know.
     pub fn write_ply_with(&self, path: impl AsRef<Path>, extra: &[(&str, &[f32])]) -> Result<(), SplatError> {
         let path = path.as_ref();
-        self.check_ply(extra)?;
+        self.check_ply(extra)
+            .map_err(|e| SplatError::Ply { path: path.to_path_buf(), reason: e.to_string() })?;
         mannequin_io::write_atomic_with(path, |w| self.encode_ply(w, extra))
             .map_err(|source| SplatError::Io { path: path.to_path_buf(), source })
     }
@@ -195,6 +196,27 @@ impl SplatScene {
         expect("SH coefficients", self.sh.len(), 3 * k)?;
         for (_, values) in extra {
             expect("extra property", values.len(), 1)?;
+        }
+        // A file must hold numbers: a NaN is refused here rather than handed to a viewer.
+        self.gaussians().validate_values()?;
+        let mut fields = vec![
+            ("mean", &self.means[..], 3),
+            ("rotation", &self.quaternions[..], 4),
+            ("scale", &self.scales[..], 3),
+            ("opacity", &self.opacities[..], 1),
+            ("SH coefficient", &self.sh[..], 3 * k),
+        ];
+        fields.extend(extra.iter().map(|(_, values)| ("extra property", *values, 1)));
+        for (field, values, per) in fields {
+            if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+                let value = f64::from(values[i]);
+                return Err(SplatError::Domain {
+                    field,
+                    index: i / per,
+                    value,
+                    expected: "expected a finite number",
+                });
+            }
         }
         Ok(())
     }
@@ -357,6 +379,32 @@ mod tests {
         let m = msg(cut);
         assert!(m.contains("at most 2") || m.contains("vertex 2 of 3"), "{m}");
         std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn non_finite_or_out_of_domain_values_are_not_written() {
+        let dir = std::env::temp_dir().join(format!("mq-splat-nan-{}", std::process::id()));
+        let path = dir.join("nan.ply");
+        type Spoil = fn(&mut SplatScene);
+        let spoil: [(&str, Spoil); 5] = [
+            ("mean of Gaussian 1 is NaN", |s| s.means[4] = f32::NAN),
+            ("rotation of Gaussian 2 is inf", |s| s.quaternions[8] = f32::INFINITY),
+            ("SH coefficient of Gaussian 0 is -inf", |s| s.sh[1] = f32::NEG_INFINITY),
+            ("opacity of Gaussian 1 is NaN", |s| s.opacities[1] = f32::NAN),
+            ("scale of Gaussian 0 is 0", |s| s.scales[0] = 0.0),
+        ];
+        for (expected, f) in spoil {
+            let mut s = scene(1);
+            f(&mut s);
+            let e = s.write_ply(&path).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("{}: {expected}", path.display())), "{e}");
+            assert!(!path.exists());
+            let e = s.ply_bytes(&[("joint_0", &[0.0, f32::NAN, 0.0])]).unwrap_err().to_string();
+            assert!(e.starts_with(expected), "{e}");
+        }
+        let e = scene(0).ply_bytes(&[("joint_0", &[0.0, f32::NAN, 0.0])]).unwrap_err().to_string();
+        assert_eq!(e, "extra property of Gaussian 1 is NaN: expected a finite number");
+        let _ = std::fs::remove_dir_all(dir);
     }
 
     /// An element of no properties before the vertices cannot declare more records than the

@@ -20,6 +20,10 @@ pub(crate) struct Buffer {
     pub bytes: Vec<u8>,
     pub views: Vec<Value>,
     pub accessors: Vec<Value>,
+    /// The first float accessor holding a non-finite value and that value's element: values
+    /// computed from checked inputs (normals, key times) can still overflow, and a file must not
+    /// carry them.
+    pub non_finite: Option<(usize, usize)>,
 }
 
 impl Buffer {
@@ -46,6 +50,11 @@ impl Buffer {
     /// `bounds` (required for POSITION and animation input).
     pub fn floats<const N: usize>(&mut self, data: &[[f32; N]], bounds: bool, target: Option<u32>) -> usize {
         let bytes: Vec<u8> = data.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        if self.non_finite.is_none()
+            && let Some(e) = data.iter().position(|x| x.iter().any(|c| !c.is_finite()))
+        {
+            self.non_finite = Some((self.accessors.len(), e));
+        }
         let view = self.view(&bytes, target);
         let mut accessor = json!({ "bufferView": view, "componentType": FLOAT, "count": data.len(), "type": element_type(N) });
         if bounds {

@@ -161,8 +161,36 @@ fn encode(
     finish(path, doc, buffer)
 }
 
+/// What refers to accessor `a` in `doc`: a mesh attribute or an animation sampler.
+fn accessor_role(doc: &Value, a: usize) -> String {
+    let meshes = doc["meshes"].as_array().into_iter().flatten();
+    for mesh in meshes {
+        let primitives = mesh["primitives"].as_array().into_iter().flatten();
+        let targets = primitives.clone().flat_map(|p| p["targets"].as_array().into_iter().flatten());
+        let attributes = primitives.map(|p| &p["attributes"]).chain(targets);
+        for map in attributes.filter_map(Value::as_object) {
+            if let Some((name, _)) = map.iter().find(|(_, v)| v.as_u64() == Some(a as u64)) {
+                return format!("mesh {} {name}", mesh["name"].as_str().unwrap_or("(unnamed)"));
+            }
+        }
+    }
+    let samplers = doc["animations"][0]["samplers"].as_array().into_iter().flatten();
+    for (i, sampler) in samplers.enumerate() {
+        for side in ["input", "output"] {
+            if sampler[side].as_u64() == Some(a as u64) {
+                return format!("animation sampler {i} {side}");
+            }
+        }
+    }
+    format!("accessor {a}")
+}
+
 /// The GLB bytes of `doc` with `buffer` as its one buffer.
 pub(crate) fn finish(path: &Path, mut doc: Value, buffer: Buffer) -> Result<Vec<u8>, MeshFileError> {
+    if let Some((a, element)) = buffer.non_finite {
+        let at = format!("{}, element {element}", accessor_role(&doc, a));
+        return Err(MeshFileError::format(path, at, "finite numbers"));
+    }
     doc["buffers"] = json!([{ "byteLength": buffer.bytes.len() }]);
     doc["bufferViews"] = json!(buffer.views);
     doc["accessors"] = json!(buffer.accessors);

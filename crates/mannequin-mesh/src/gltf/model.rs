@@ -40,20 +40,32 @@ pub struct SkinnedLayer {
 
 impl SkinnedLayer {
     pub(crate) fn validate(&self, path: &Path, joints: usize) -> Result<(), MeshFileError> {
-        let expected = self.mesh.vertex_count() * joints;
-        if self.weights.len() != expected {
-            return Err(invalid(
-                path,
-                format!("layer {} weights", self.name),
-                format!(
-                    "{expected} values ({} vertices × {joints} joints), found {}",
-                    self.mesh.vertex_count(),
-                    self.weights.len()
-                ),
-            ));
-        }
-        Ok(())
+        let layer = |e| MeshFileError::format(path, format!("layer {}", self.name), format!("{e}"));
+        self.mesh.validate().map_err(layer)?;
+        check_weights(
+            path,
+            &format!("layer {} weights", self.name),
+            &self.weights,
+            self.mesh.vertex_count(),
+            joints,
+        )
     }
+}
+
+/// `weights` as `v` rows of `j` finite non-negative skinning weights; `at` names them.
+fn check_weights(path: &Path, at: &str, weights: &[f32], v: usize, j: usize) -> Result<(), MeshFileError> {
+    if weights.len() != v * j {
+        let expected = format!("{} values ({v} vertices × {j} joints), found {}", v * j, weights.len());
+        return Err(invalid(path, at, expected));
+    }
+    if let Some(k) = weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
+        return Err(invalid(
+            path,
+            format!("{at}[vertex {}, joint {}]", k / j, k % j),
+            format!("a finite non-negative weight, found {}", weights[k]),
+        ));
+    }
+    Ok(())
 }
 
 /// A motion for a skeleton: one pose per frame at a fixed rate.
@@ -119,22 +131,7 @@ impl SkinnedMesh {
     pub(crate) fn validate(&self, path: &Path) -> Result<(), MeshFileError> {
         self.mesh.validate().map_err(|e| MeshFileError::invalid(path, e))?;
         self.skeleton.validate(path)?;
-        let (v, j) = (self.mesh.vertex_count(), self.skeleton.joint_count());
-        if self.weights.len() != v * j {
-            return Err(invalid(
-                path,
-                "weights",
-                format!("{} values ({v} vertices × {j} joints), found {}", v * j, self.weights.len()),
-            ));
-        }
-        if let Some(k) = self.weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
-            return Err(invalid(
-                path,
-                format!("weights[vertex {}, joint {}]", k / j, k % j),
-                format!("a finite non-negative weight, found {}", self.weights[k]),
-            ));
-        }
-        Ok(())
+        check_weights(path, "weights", &self.weights, self.mesh.vertex_count(), self.skeleton.joint_count())
     }
 }
 
