@@ -155,11 +155,17 @@ pub fn weight_shapes() -> Vec<(String, Vec<usize>)> {
 }
 
 impl Lpips {
+    /// Reads the weights, refusing a non-finite value anywhere and a negative linear-layer
+    /// weight (LPIPS trains them clamped at 0; a negative one makes a distance negative).
     pub fn from_npz(npz: &Npz) -> Result<Self, DataError> {
         let mut arrays = Vec::new();
         for (key, shape) in weight_shapes() {
             let expected: Vec<Option<usize>> = shape.iter().map(|&d| Some(d)).collect();
-            let (_, v) = npz.f64_with_shape(&key, &expected)?;
+            let (_, v) = if key.starts_with("lin") {
+                npz.f64_in_range(&key, &expected, 0.0..=f64::INFINITY)?
+            } else {
+                npz.finite_f64_with_shape(&key, &expected)?
+            };
             arrays.push(v.into_iter().map(|x| x as f32).collect::<Vec<f32>>());
         }
         let mut arrays = arrays.into_iter();
@@ -231,5 +237,43 @@ impl Lpips {
 
     pub fn distance(&self, a: &Image, b: &Image) -> Result<f64, DataError> {
         Ok(self.per_layer(a, b)?.iter().sum())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mannequin_io::{NpyArray, NpzWriter};
+
+    /// Weights of every expected shape, all 0.01, with `key`'s element 0 set to `bad`.
+    fn weights_with(key: &str, bad: f32) -> Npz {
+        let mut w = NpzWriter::new();
+        for (k, shape) in weight_shapes() {
+            let mut values = vec![0.01f32; shape.iter().product()];
+            if k == key {
+                values[0] = bad;
+            }
+            w.add(&k, NpyArray::f32(shape, values));
+        }
+        Npz::from_bytes("alex.npz".into(), &w.to_bytes()).unwrap()
+    }
+
+    #[test]
+    fn a_non_finite_weight_is_refused_naming_the_file_and_array() {
+        for key in ["net.slice3.6.weight", "net.slice1.0.bias", "lin2.model.1.weight"] {
+            for bad in [f32::NAN, f32::INFINITY] {
+                let e = Lpips::from_npz(&weights_with(key, bad)).err().expect(key).to_string();
+                assert!(e.starts_with(&format!("alex.npz: field '{key}': element 0 is ")), "{e}");
+            }
+        }
+        assert!(Lpips::from_npz(&weights_with("lin0.model.1.weight", 0.0)).is_ok());
+    }
+
+    #[test]
+    fn a_negative_linear_weight_is_refused() {
+        let e = Lpips::from_npz(&weights_with("lin4.model.1.weight", -0.5)).err().unwrap().to_string();
+        assert!(e.contains("field 'lin4.model.1.weight': element 0 is -0.5: expected 0–inf"), "{e}");
+        // Convolutions may be negative.
+        assert!(Lpips::from_npz(&weights_with("net.slice5.10.weight", -0.5)).is_ok());
     }
 }
