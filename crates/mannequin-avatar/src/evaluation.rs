@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 
 use burn::tensor::Device;
 use mannequin_data::evaluation::{EvalOptions, evaluate};
-use mannequin_data::{DataError, Dataset, Scores, TestSet};
+use mannequin_data::staged::StagedDir;
+use mannequin_data::{Dataset, Scores, TestSet};
 
 use crate::avatar::Avatar;
 use crate::error::AvatarError;
@@ -23,8 +24,9 @@ fn test_sets(data: &Path) -> Vec<(TestSet, PathBuf)> {
     if nested.is_empty() { vec![(TestSet::Test, data.to_path_buf())] } else { nested }
 }
 
-/// Renders and scores every test set; predictions are written afresh under
-/// `MODEL/eval/<set>/` (an earlier run's are removed first).
+/// Renders and scores every test set. Predictions are written under temporary names in `MODEL`
+/// and replace an earlier run's `MODEL/eval/<set>/` only once every set is scored, so a failed
+/// evaluation leaves the model folder as it was.
 /// `on_set(set, frames)` is called before each set, `on_frame` after each render and each score.
 pub fn evaluate_avatar(
     model: &Path,
@@ -35,16 +37,22 @@ pub fn evaluate_avatar(
 ) -> Result<Scores, AvatarError> {
     let avatar = Avatar::load(model, &Device::flex())?;
     let mut summaries = Vec::new();
+    let mut staged = Vec::new();
     for (set, dir) in test_sets(data) {
         let dataset = Dataset::open(&dir, 1)?;
         let frames = dataset.split("test")?.frames;
         let out = model.join("eval").join(set.name());
-        if out.exists() {
-            std::fs::remove_dir_all(&out).map_err(|e| DataError::os(&out, e))?;
-        }
+        let temp = model.join(format!(".eval-{}.partial-{}", set.name(), std::process::id()));
+        let stage = StagedDir::new(temp, out.clone())?;
         on_set(set, frames.len());
-        predict_split(&avatar, &dataset, "test", &out, on_frame)?;
-        summaries.push((set, evaluate(&out, &dir, &frames, options, &|_| on_frame())?));
+        predict_split(&avatar, &dataset, "test", stage.path(), on_frame)?;
+        let mut summary = evaluate(stage.path(), &dir, &frames, options, &|_| on_frame())?;
+        summary.pred = out;
+        summaries.push((set, summary));
+        staged.push(stage);
+    }
+    for stage in staged {
+        stage.keep()?;
     }
     Ok(Scores::new(summaries))
 }

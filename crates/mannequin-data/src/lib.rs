@@ -18,6 +18,7 @@ pub mod poses;
 pub mod rng;
 pub mod scores;
 pub mod splits;
+pub mod staged;
 pub mod writer;
 
 pub use dataset::{Cameras, Dataset, Frame, Split};

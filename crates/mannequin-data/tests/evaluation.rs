@@ -185,3 +185,30 @@ fn each_garment_is_scored_against_its_own_ground_truth() {
         std::fs::remove_dir_all(d).unwrap();
     }
 }
+
+/// Geometry scores are numbers or an error, never null: no samples and a mesh without a surface
+/// are refused, naming what is wrong.
+#[test]
+fn geometry_without_samples_or_surface_is_refused() {
+    let gt = write_gt("gt-surface", 32, 1);
+    let pred = temp_dir("pred-surface");
+    let w = DatasetWriter::new(&pred);
+    w.write_frame(&perfect_prediction(0, 32)).unwrap();
+    w.write_mesh(0, &tetrahedron(0.0)).unwrap();
+    let none = EvalOptions { samples: 0, ..options() };
+    let msg = evaluate(&pred, &gt, &[0], &none, &|_| {}).err().unwrap().to_string();
+    assert!(msg.contains("surface samples per mesh: expected 1 to 1000000, found 0"), "{msg}");
+
+    let mut flat = tetrahedron(0.0);
+    flat.faces.clear();
+    w.write_mesh(0, &flat).unwrap();
+    let msg = evaluate(&pred, &gt, &[0], &options(), &|_| {}).err().unwrap().to_string();
+    assert!(msg.contains("mesh_0000.ply: faces: expected a surface to score"), "{msg}");
+    flat.faces = vec![[0, 1, 1]];
+    w.write_mesh(0, &flat).unwrap();
+    let msg = evaluate(&pred, &gt, &[0], &options(), &|_| {}).err().unwrap().to_string();
+    assert!(msg.contains("found 1 faces on 4 vertices"), "{msg}");
+    for d in [gt, pred] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
+}

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use mannequin_avatar::evaluation::evaluate_avatar;
-use mannequin_data::evaluation::{EvalOptions, evaluate, test_frames};
+use mannequin_data::evaluation::{EvalOptions, MAX_SURFACE_SAMPLES, evaluate, test_frames};
 use mannequin_data::metrics::lpips::Lpips;
 use mannequin_data::{Scores, TestSet};
 
@@ -44,8 +44,8 @@ pub struct Args {
     #[arg(long, default_value = "white")]
     background: String,
     /// Surface samples per mesh for Chamfer, P2S and normal consistency.
-    #[arg(long, default_value_t = 100_000)]
-    samples: usize,
+    #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..=MAX_SURFACE_SAMPLES as u64))]
+    samples: u64,
     /// Seed of the surface samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -131,7 +131,7 @@ pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("eval");
     let background = parse_background(&args.background)?;
     let lpips = args.lpips_weights.as_deref().map(Lpips::load).transpose()?;
-    let options = EvalOptions { background, lpips, samples: args.samples, seed: args.seed };
+    let options = EvalOptions { background, lpips, samples: args.samples as usize, seed: args.seed };
     let scores = match (&args.avatar, &args.data, &args.pred, &args.gt) {
         (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, &options)?,
         (_, _, Some(pred), Some(gt)) => {
