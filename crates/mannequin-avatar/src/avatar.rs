@@ -17,7 +17,7 @@ use crate::fused_binding::{self, BindConfig};
 use crate::host_ops;
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
-use crate::params::{Param, tensor_from};
+use crate::params::{ANY_FINITE, Param, tensor_from};
 use crate::sh_colour::{ColourConfig, colour_convention, sh_colour, sh_colour_tensors};
 use mannequin_data::rng::SplitMix64;
 
@@ -115,20 +115,7 @@ fn flat(v: &[[f32; 3]]) -> Vec<f32> {
 impl Avatar {
     /// A fresh avatar on `device` (an autodiff device for training) with seeded initialisation.
     pub fn new(config: AvatarConfig, canonical: Canonical, device: &Device) -> Result<Self, AvatarError> {
-        if config.sh_degree > 2 {
-            return Err(AvatarError::Invalid(format!("SH degree {} (0 to 2 supported)", config.sh_degree)));
-        }
-        if !(config.dilation.is_finite() && config.dilation >= 0.0) {
-            return Err(AvatarError::Invalid(format!(
-                "screen-filter dilation {} px² (expected a finite value >= 0)",
-                config.dilation
-            )));
-        }
-        if config.method == Method::Tavatar && !config.face_gaussians && !config.vertex_gaussians {
-            return Err(AvatarError::Invalid(
-                "face and vertex Gaussians are both off: nothing to render".into(),
-            ));
-        }
+        config.validate().map_err(AvatarError::Invalid)?;
         let (v, f) = (canonical.num_vertices(), canonical.faces.len());
         let index = MeshIndex::new(v, &canonical.faces, device);
         let vertices = tensor_from(flat(&canonical.vertices), v, 3, device);
@@ -433,16 +420,17 @@ impl Avatar {
             let text = std::fs::read_to_string(&path).map_err(|e| AvatarError::file(&path, e.to_string()))?;
             serde_json::from_str(&text).map_err(|e| AvatarError::file(&path, e.to_string()))?
         };
-        let canonical = Canonical::read(&npz, &npz_path)?;
+        config.validate().map_err(|e| npz.field_error(CONFIG_MEMBER, e))?;
+        let canonical = Canonical::read(&npz)?;
         let mut avatar = Self::new(config, canonical, device)?;
-        avatar.load_params(&npz, "param/", &npz_path)?;
+        avatar.load_params(&npz, "param/")?;
         Ok(avatar)
     }
 
     /// Replaces every parameter with `{prefix}{name}` from `npz`.
-    pub fn load_params(&mut self, npz: &Npz, prefix: &str, path: &Path) -> Result<(), AvatarError> {
+    pub fn load_params(&mut self, npz: &Npz, prefix: &str) -> Result<(), AvatarError> {
         for p in &mut self.params {
-            p.load(npz, prefix, path)?;
+            p.load(npz, prefix, ANY_FINITE)?;
         }
         Ok(())
     }

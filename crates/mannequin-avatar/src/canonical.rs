@@ -2,16 +2,27 @@
 //! its rig, optionally midpoint-subdivided for more Gaussians. A model directory stores it, so a
 //! trained avatar needs neither the body-model file nor the dataset again.
 
-use std::path::Path;
-
 use mannequin_body::{BodyModel, lbs::shape_body};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;
 
 use crate::error::AvatarError;
 use crate::garment_layer::{BODY, GarmentLayer};
+use crate::params::ANY_FINITE;
 use crate::skirt_layer::{SkirtLayer, SkirtMode, fit_skirt};
 use crate::views::View;
+
+/// Most midpoint subdivisions of a subject's mesh: each quadruples the faces (each a Gaussian or
+/// two), and three already make 64 times the template's.
+pub const MAX_SUBDIVISIONS: usize = 3;
+
+fn check_subdivisions(subdivisions: usize) -> Result<(), AvatarError> {
+    if subdivisions > MAX_SUBDIVISIONS {
+        let reason = format!("{subdivisions} subdivisions (expected at most {MAX_SUBDIVISIONS})");
+        return Err(AvatarError::Invalid(reason));
+    }
+    Ok(())
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Canonical {
@@ -37,6 +48,7 @@ pub struct Canonical {
 impl Canonical {
     /// Shapes `model` by `betas` (zero-padded) and subdivides `subdivisions` times.
     pub fn from_body(model: &BodyModel, betas: &[f32], subdivisions: usize) -> Result<Self, AvatarError> {
+        check_subdivisions(subdivisions)?;
         let shaped = shape_body(model, betas)?;
         let mut c = Self {
             vertices: shaped.vertices.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect(),
@@ -66,6 +78,7 @@ impl Canonical {
         mode: SkirtMode,
         garments: &[GarmentLayer],
     ) -> Result<(Self, Option<SkirtLayer>), AvatarError> {
+        check_subdivisions(subdivisions)?;
         let body = Self::from_body(model, betas, 0)?;
         let layer = fit_skirt(&body, views, mode)?;
         let mut c = match &layer {
@@ -142,29 +155,45 @@ impl Canonical {
     }
 
     /// Reads what [`Canonical::write`] wrote, checking every shape against the vertex and joint
-    /// counts.
-    pub fn read(npz: &Npz, path: &Path) -> Result<Self, AvatarError> {
-        let f32s = |key: &str, shape: &[Option<usize>]| -> Result<(Vec<usize>, Vec<f32>), AvatarError> {
-            let (s, d) = npz.f64_with_shape(key, shape)?;
-            Ok((s, d.into_iter().map(|x| x as f32).collect()))
+    /// counts and every value against its meaning: finite numbers, offset gates in [0, 1], faces
+    /// and parents that index what is there.
+    pub fn read(npz: &Npz) -> Result<Self, AvatarError> {
+        let f32s = |key: &str, shape: &[Option<usize>], allowed| -> Result<Vec<f32>, AvatarError> {
+            let (_, d) = npz.f64_in_range(key, shape, allowed)?;
+            Ok(d.into_iter().map(|x| x as f32).collect())
         };
-        let (_, vertices) = f32s("vertices", &[None, Some(3)])?;
+        let vertices = f32s("vertices", &[None, Some(3)], ANY_FINITE)?;
         let v = vertices.len() / 3;
-        let (_, joints) = f32s("joints", &[None, Some(3)])?;
+        let joints = f32s("joints", &[None, Some(3)], ANY_FINITE)?;
         let j = joints.len() / 3;
-        let (_, weights) = f32s("weights", &[Some(v), Some(j)])?;
-        let (_, posedirs) = f32s("posedirs", &[None, Some(3 * v)])?;
+        if j == 0 {
+            return Err(npz.field_error("joints", "expected at least one joint, found none").into());
+        }
+        let weights = f32s("weights", &[Some(v), Some(j)], ANY_FINITE)?;
+        // Pose correctives: none, or a row per rotation-matrix entry of every joint but the root.
+        let none = npz.get("posedirs").is_some_and(|a| a.shape.first() == Some(&0));
+        let rows = if none { 0 } else { 9 * (j - 1) };
+        let posedirs = f32s("posedirs", &[Some(rows), Some(3 * v)], ANY_FINITE)?;
         let (_, faces) = npz.f64_with_shape("faces", &[None, Some(3)])?;
         let (_, parents) = npz.f64_with_shape("parents", &[Some(j)])?;
         // Models saved before garment layers existed let the field move every vertex.
-        let offset_gate =
-            if npz.contains("offset_gate") { f32s("offset_gate", &[Some(v)])?.1 } else { vec![1.0; v] };
-        let bad = |field: &str, reason: String| AvatarError::file(path, format!("{field}: {reason}"));
+        let offset_gate = if npz.contains("offset_gate") {
+            f32s("offset_gate", &[Some(v)], 0.0..=1.0)?
+        } else {
+            vec![1.0; v]
+        };
+        let bad = |field: &str, reason: String| AvatarError::from(npz.field_error(field, reason));
+        if v == 0 || faces.is_empty() {
+            return Err(bad(
+                "faces",
+                format!("expected a mesh, found {} faces on {v} vertices", faces.len() / 3),
+            ));
+        }
         // Models saved before garment layers are all body.
         let (layer, layer_names) = if npz.contains("layer") {
             let names: Vec<String> = npz.text("layer_names")?.split('\n').map(String::from).collect();
             let (_, layer) = npz.f64_with_shape("layer", &[Some(v)])?;
-            if let Some(l) = layer.iter().find(|&&l| l < 0.0 || l as usize >= names.len()) {
+            if let Some(l) = layer.iter().find(|&&l| !(l >= 0.0 && (l as usize) < names.len())) {
                 return Err(bad("layer", format!("layer {l} of {} named in layer_names", names.len())));
             }
             (layer.into_iter().map(|l| l as u8).collect(), names)
@@ -187,7 +216,7 @@ impl Canonical {
             .enumerate()
             .map(|(k, &p)| match p {
                 p if p < 0.0 => Ok(None),
-                p if (p as usize) < k => Ok(Some(p as usize)),
+                p if p >= 0.0 && (p as usize) < k => Ok(Some(p as usize)),
                 _ => Err(bad("parents", format!("joint {k} has parent {p}, expected an earlier joint"))),
             })
             .collect::<Result<_, _>>()?;

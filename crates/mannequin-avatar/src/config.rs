@@ -1,6 +1,9 @@
 //! What an avatar is made of, saved next to its parameters as `avatar.json`.
 
+use mannequin_io::limits::MAX_ARRAY_ELEMENTS;
 use serde::{Deserialize, Serialize};
+
+use crate::hash_grid::HashGridConfig;
 
 /// The screen filter the avatar renders with (px², the renderer's `dilation`). 3DGS's 0.3 widens
 /// an edge-on opaque disk to alpha ½ at ≈0.65 px past the surface; fitting masks and colour then
@@ -9,6 +12,14 @@ use serde::{Deserialize, Serialize};
 /// synthetic subject 0 (2,000 iterations) Chamfer went 0.507 → 0.352 cm and novel-view PSNR
 /// 32.3 → 33.1 dB.
 pub const AVATAR_DILATION: f64 = 0.1;
+
+/// Most hash-grid levels an avatar may have: instant-ngp and both papers use 16, and every level
+/// costs a table lookup per point.
+pub const MAX_HASH_LEVELS: usize = 32;
+
+/// Widest hidden layer of an avatar's MLPs: the papers use 64, and a layer's activations cost
+/// this many floats per canonical vertex.
+pub const MAX_HIDDEN_WIDTH: usize = 1024;
 
 /// What models saved before the setting existed were trained with: the renderer's default.
 fn legacy_dilation() -> f64 {
@@ -62,6 +73,52 @@ pub struct AvatarConfig {
 }
 
 impl AvatarConfig {
+    /// The hash grid of the avatar's fields.
+    pub fn hash_grid(&self) -> HashGridConfig {
+        HashGridConfig {
+            levels: self.hash_levels,
+            log2_table_size: self.hash_log2_table,
+            base_resolution: self.hash_base_resolution,
+            growth: self.hash_growth,
+            features_per_level: self.hash_features,
+        }
+    }
+
+    /// Refuses settings no avatar can be built with, and sizes past the limits: read from a
+    /// model file, they are checked before anything is allocated for them.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.sh_degree > 2 {
+            return Err(format!("SH degree {} (0 to 2 supported)", self.sh_degree));
+        }
+        if !(self.dilation.is_finite() && self.dilation >= 0.0) {
+            return Err(format!(
+                "screen-filter dilation {} px² (expected a finite value >= 0)",
+                self.dilation
+            ));
+        }
+        if self.method == Method::Tavatar && !self.face_gaussians && !self.vertex_gaussians {
+            return Err("face and vertex Gaussians are both off: nothing to render".into());
+        }
+        if !(1..=MAX_HIDDEN_WIDTH).contains(&self.hidden) {
+            return Err(format!("hidden width {} (expected 1 to {MAX_HIDDEN_WIDTH})", self.hidden));
+        }
+        if self.hash_levels > MAX_HASH_LEVELS {
+            return Err(format!(
+                "{} hash-grid levels (expected at most {MAX_HASH_LEVELS})",
+                self.hash_levels
+            ));
+        }
+        let grid = self.hash_grid();
+        grid.validate().map_err(|e| format!("hash grid: {e}"))?;
+        let entries = grid.table_rows() * grid.features_per_level;
+        if entries > MAX_ARRAY_ELEMENTS {
+            return Err(format!(
+                "a hash-grid table of {entries} values (expected at most {MAX_ARRAY_ELEMENTS}, what one stored array may hold)"
+            ));
+        }
+        Ok(())
+    }
+
     /// The seeds' settings for `method`.
     pub fn new(method: Method, seed: u64) -> Self {
         Self {

@@ -7,7 +7,7 @@ use mannequin_data::rng::SplitMix64;
 
 use crate::config::AvatarConfig;
 use crate::error::AvatarError;
-use crate::hash_grid::{Aabb, DeviceLookup, HashGridConfig, HashGridLookup, encode, init_table};
+use crate::hash_grid::{Aabb, DeviceLookup, HashGridLookup, encode, init_table};
 use crate::mlp::Mlp;
 use crate::params::Param;
 
@@ -34,13 +34,7 @@ impl Field {
         device: &Device,
         params: &mut Vec<Param>,
     ) -> Result<Self, AvatarError> {
-        let grid = HashGridConfig {
-            levels: config.hash_levels,
-            log2_table_size: config.hash_log2_table,
-            base_resolution: config.hash_base_resolution,
-            growth: config.hash_growth,
-            features_per_level: config.hash_features,
-        };
+        let grid = config.hash_grid();
         let grid_error =
             |e: crate::hash_grid::HashGridError| AvatarError::Invalid(format!("{name} field: {e}"));
         let aabb = Aabb::enclosing(points, BOX_MARGIN).map_err(grid_error)?;

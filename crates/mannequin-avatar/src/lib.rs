@@ -6,6 +6,7 @@ pub mod adam;
 pub mod antialias;
 pub mod avatar;
 pub mod canonical;
+pub mod checkpoint;
 pub mod colour_init;
 pub mod config;
 pub mod error;
@@ -31,6 +32,7 @@ pub mod views;
 
 pub use avatar::{Avatar, Posed, Rendered};
 pub use canonical::Canonical;
+pub use checkpoint::Checkpoint;
 pub use config::{AVATAR_DILATION, AvatarConfig, Method};
 pub use error::AvatarError;
 pub use predict::{Prediction, predict, predict_split};

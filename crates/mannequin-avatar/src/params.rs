@@ -2,12 +2,15 @@
 //! checkpoint stores. Keeping them as plain named arrays makes checkpoints ordinary `.npz`
 //! files that numpy can open.
 
-use std::path::Path;
+use std::ops::RangeInclusive;
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
+
+/// Any finite value, for [`Param::load`].
+pub const ANY_FINITE: RangeInclusive<f64> = f64::NEG_INFINITY..=f64::INFINITY;
 
 #[derive(Clone, Debug)]
 pub struct Param {
@@ -48,14 +51,12 @@ impl Param {
         Self { name: name.to_string(), value: trainable(value), lr }
     }
 
-    /// Reads `{prefix}{name}` from `npz`, which must have this parameter's shape.
-    pub fn load(&mut self, npz: &Npz, prefix: &str, path: &Path) -> Result<(), AvatarError> {
+    /// Reads `{prefix}{name}` from `npz`, which must have this parameter's shape and only values
+    /// in `allowed` (finite always).
+    pub fn load(&mut self, npz: &Npz, prefix: &str, allowed: RangeInclusive<f64>) -> Result<(), AvatarError> {
         let [r, c] = self.value.dims();
         let key = format!("{prefix}{}", self.name);
-        let (_, values) = npz.f64_with_shape(&key, &[Some(r), Some(c)])?;
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(AvatarError::file(path, format!("{key}: value {i} is not finite")));
-        }
+        let (_, values) = npz.f64_in_range(&key, &[Some(r), Some(c)], allowed)?;
         let device = self.value.device();
         self.value = trainable(tensor_from(values.into_iter().map(|v| v as f32).collect(), r, c, &device));
         Ok(())

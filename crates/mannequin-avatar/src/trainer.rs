@@ -6,10 +6,11 @@ use std::time::{Duration, Instant};
 
 use burn::tensor::{Gradients, Tensor, TensorData};
 use mannequin_data::rng::SplitMix64;
-use mannequin_io::{NpyArray, Npz, NpzWriter};
+use mannequin_io::{NpyArray, NpzWriter};
 
 use crate::adam::Adam;
 use crate::avatar::Avatar;
+use crate::checkpoint::Checkpoint;
 use crate::config::Method;
 use crate::error::AvatarError;
 use crate::losses::{MeshTopology, photometric_weighted};
@@ -354,14 +355,13 @@ impl Trainer {
     }
 
     /// Continues from a checkpoint written by [`Trainer::save_checkpoint`], refusing one whose
-    /// record differs from `run` in any setting.
-    pub fn resume(&mut self, path: &Path, run: &TrainingRun) -> Result<(), AvatarError> {
-        let npz = Npz::read(path)?;
-        run.check(&npz, &[])?;
-        let (_, it) = npz.f64_with_shape("iteration", &[Some(1)])?;
-        self.avatar.load_params(&npz, "param/", path)?;
-        self.adam = Adam::load(&self.avatar.params, &npz, path)?;
-        self.iteration = it[0] as usize;
+    /// record differs from `run` in any setting, or whose arrays do not fit this avatar.
+    pub fn resume(&mut self, checkpoint: &Checkpoint, run: &TrainingRun) -> Result<(), AvatarError> {
+        let npz = &checkpoint.npz;
+        run.check(npz, &[])?;
+        self.avatar.load_params(npz, "param/")?;
+        self.adam = Adam::load(&self.avatar.params, npz, checkpoint.iteration)?;
+        self.iteration = checkpoint.iteration;
         Ok(())
     }
 }

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use burn::tensor::Device;
 use mannequin_avatar::{
-    Avatar, AvatarConfig, AvatarError, Canonical, Method, SkirtMode, TrainOptions, Trainer, TrainingRun,
-    load_views,
+    Avatar, AvatarConfig, AvatarError, Canonical, Checkpoint, Method, SkirtMode, TrainOptions, Trainer,
+    TrainingRun, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::{Dataset, Fingerprint};
@@ -90,11 +90,12 @@ fn resume_matches() {
         first.save_checkpoint(&checkpoint, &record(&first, &data)).unwrap();
         drop(first);
         // A run of another length is refused: its learning rates would decay differently.
-        let mut longer = trainer(&data, method, 7);
-        let e = longer.resume(&checkpoint, &record(&longer, &data)).unwrap_err().to_string();
+        let longer = trainer(&data, method, 7);
+        let e = Checkpoint::open(&checkpoint, &record(&longer, &data), &[]).err().unwrap().to_string();
         assert!(e.contains("options.iters was 6, now 7"), "{e}");
         let mut resumed = trainer(&data, method, 6);
-        resumed.resume(&checkpoint, &record(&resumed, &data)).unwrap();
+        let run = record(&resumed, &data);
+        resumed.resume(&Checkpoint::open(&checkpoint, &run, &[]).unwrap(), &run).unwrap();
         assert_eq!(resumed.iteration, 3);
         for _ in 0..3 {
             resumed.step().unwrap();
@@ -138,5 +139,78 @@ fn a_missing_mask_is_an_error_before_training() {
     std::fs::remove_file(data.join("masks/mask_0003.npy")).unwrap();
     let e = Dataset::open(&data, 1).unwrap_err().to_string();
     assert!(e.contains("mask_0003.npy") && e.contains("missing mask"), "{e}");
+    std::fs::remove_dir_all(data).ok();
+}
+
+/// `checkpoint` written to `to` with `key` replaced by `array`.
+fn with_array(checkpoint: &Path, to: &Path, key: &str, array: mannequin_io::NpyArray) {
+    let npz = mannequin_io::Npz::read(checkpoint).unwrap();
+    let mut w = mannequin_io::NpzWriter::uncompressed();
+    for k in npz.keys().filter(|&k| k != key) {
+        w.add(k, npz.get(k).unwrap().clone());
+    }
+    w.add(key, array);
+    w.write(to).unwrap();
+}
+
+/// A checkpoint edited by hand or cut short resumes into NaN unless refused: every counter,
+/// moment and parameter is checked, naming the file and the field.
+#[test]
+fn a_corrupt_checkpoint_is_refused_naming_its_field() {
+    use mannequin_io::NpyArray;
+    let data = subject("corrupt");
+    let mut t = trainer(&data, Method::Tavatar, 6);
+    for _ in 0..2 {
+        t.step().unwrap();
+    }
+    let good = data.join("good.npz");
+    let run = record(&t, &data);
+    t.save_checkpoint(&good, &run).unwrap();
+    let first = &t.avatar.params[0];
+    let [r, c] = first.value.dims();
+    let corrupt = |i: usize, value: f32| {
+        let mut v = vec![0.001f32; r * c];
+        v[i] = value;
+        NpyArray::f32(vec![r, c], v)
+    };
+    let (v, m, p) =
+        (format!("adam_v/{}", first.name), format!("adam_m/{}", first.name), format!("param/{}", first.name));
+    let cases = [
+        (
+            "iteration",
+            NpyArray::i64(vec![1], vec![-5]),
+            "expected an iteration from 0 to 6 (the run's --iters), found -5",
+        ),
+        ("iteration", NpyArray::i64(vec![1], vec![1 << 62]), "found 4611686018427387904"),
+        ("iteration", NpyArray::i64(vec![1], vec![7]), "from 0 to 6"),
+        ("iteration", NpyArray::f64(vec![1], vec![2.5]), "expected one integer"),
+        (
+            "adam_step",
+            NpyArray::i64(vec![1], vec![0]),
+            "expected 2 (one optimiser step per iteration), found 0",
+        ),
+        (v.as_str(), corrupt(3, -1.0), "element 3 is -1: expected 0–inf"),
+        (v.as_str(), corrupt(0, f32::INFINITY), "is inf"),
+        (m.as_str(), corrupt(1, f32::NAN), "is NaN: expected a finite number"),
+        (p.as_str(), corrupt(0, f32::NAN), "is NaN"),
+        (p.as_str(), NpyArray::f32(vec![r + 1, c], vec![0.0; (r + 1) * c]), "expected shape"),
+    ];
+    for (key, array, expected) in cases {
+        let path = data.join("bad.npz");
+        with_array(&good, &path, key, array);
+        let mut fresh = trainer(&data, Method::Tavatar, 6);
+        let e = match Checkpoint::open(&path, &run, &[]) {
+            Err(e) => e,
+            Ok(c) => fresh.resume(&c, &run).expect_err(key),
+        }
+        .to_string();
+        assert!(
+            e.contains("bad.npz") && e.contains(&format!("'{key}'")) && e.contains(expected),
+            "{key}: {e}"
+        );
+    }
+    let mut fresh = trainer(&data, Method::Tavatar, 6);
+    fresh.resume(&Checkpoint::open(&good, &run, &[]).unwrap(), &run).unwrap();
+    assert_eq!(fresh.iteration, 2);
     std::fs::remove_dir_all(data).ok();
 }

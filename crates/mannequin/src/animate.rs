@@ -86,13 +86,24 @@ fn animate_avatar(args: &Args, motion: &Motion) -> Result<()> {
             clip_camera(lo, hi)
         }
     };
+    let created = !args.output.exists();
     std::fs::create_dir_all(&args.output).with_context(|| format!("creating {}", args.output.display()))?;
+    let frame_path = |f: usize| args.output.join(format!("frame_{f:04}.png"));
     let progress = bar(frames as u64, "rendering");
-    for f in 0..frames {
+    let rendered = (0..frames).try_for_each(|f| {
         let p = predict(&avatar, &camera, pose(f), transl(f))?;
-        write_map(&p, args.what, &args.output.join(format!("frame_{f:04}.png")))?;
+        write_map(&p, args.what, &frame_path(f))?;
         progress.inc(1);
+        anyhow::Ok(())
+    });
+    if rendered.is_err() {
+        // Half a clip is no result: the frames written go, and the folder if this run made it.
+        (0..frames).for_each(|f| drop(std::fs::remove_file(frame_path(f))));
+        if created {
+            let _ = std::fs::remove_dir(&args.output);
+        }
     }
+    rendered?;
     progress.finish_and_clear();
     tracing::info!(
         "wrote {} frames ({}×{}) to {}",

@@ -4,13 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use burn::tensor::Device;
 use mannequin_avatar::params::host_rows;
 use mannequin_avatar::{Avatar, Posed, export};
 use mannequin_body::{Motion, skeletal_animation};
 use mannequin_mesh::TriMesh;
-use mannequin_mesh::gltf::SkeletalAnimation;
+use mannequin_mesh::gltf::{SkeletalAnimation, scene_glb_bytes};
 
 use crate::body::write_mesh;
 use crate::pose_choice::PoseChoice;
@@ -54,32 +54,41 @@ fn is_glb(path: &Path) -> Result<bool> {
     }
 }
 
-/// Writes the mesh: skinned `.glb` at the bind pose, or `.obj`/`.ply` at the pose (V_s exactly
-/// when `canonical`); each with vertex colour baked from the Gaussians.
-fn write_output(
+/// One file of an export, made whole in memory and checked before any file is written, so an
+/// export that fails writes none.
+enum Made {
+    /// An `.obj` or `.ply` mesh, already validated.
+    Mesh(TriMesh),
+    Bytes(Vec<u8>),
+}
+
+/// The mesh files: a skinned `.glb` at the bind pose, or `.obj`/`.ply` at the pose (V_s exactly
+/// when `canonical`) with a file per garment layer beside it; each with vertex colour baked from
+/// the Gaussians.
+fn mesh_files(
     avatar: &Avatar,
     posed: &Posed,
     canonical: bool,
     glb: Option<Option<&Motion>>,
     output: &Path,
-) -> Result<()> {
+) -> Result<Vec<(PathBuf, Made)>> {
     if let Some(motion) = glb {
         let (body, layers) = export::skinned_layers(avatar, posed)?;
         let animation = motion.map(|m| avatar_animation(avatar, m)).transpose()?;
-        return mannequin_mesh::gltf::write_layered_glb(output, &body, &layers, animation.as_ref())
-            .with_context(|| format!("writing {}", output.display()));
+        let bytes = scene_glb_bytes(output, &body, &layers, animation.as_ref(), &[])?;
+        return Ok(vec![(output.to_path_buf(), Made::Bytes(bytes))]);
     }
     let vertices = if canonical { &posed.personalised } else { &posed.vertices };
     let mut mesh = TriMesh::new(host_rows(vertices.clone()), avatar.canonical.faces.clone());
     mesh.colors = Some(export::vertex_colours(avatar, posed)?);
-    write_mesh(output, &mesh)?;
-    for name in avatar.canonical.garment_names() {
+    // A layer is part of the mesh: valid if the whole is.
+    mesh.validate().map_err(|e| anyhow!("{}: {e}", output.display()))?;
+    let layers = avatar.canonical.garment_names().iter().map(|name| {
         let part = avatar.canonical.layer_mesh(name, &mesh).expect("a layer the canonical mesh names");
-        let path = layer_path(output, name);
-        write_mesh(&path, &part)?;
-        tracing::info!("wrote {} (the {name} layer)", path.display());
-    }
-    Ok(())
+        (layer_path(output, name), Made::Mesh(part))
+    });
+    let layers: Vec<_> = layers.collect();
+    Ok([(output.to_path_buf(), Made::Mesh(mesh))].into_iter().chain(layers).collect())
 }
 
 /// Where a layer of `output` goes: `<stem>.<layer>.<extension>` beside it.
@@ -125,19 +134,28 @@ pub fn run(args: Args) -> Result<()> {
     let avatar = Avatar::load(&args.avatar, &Device::flex())?;
     let (pose, transl) = args.pose.resolve(avatar.canonical.num_joints())?;
     let posed = avatar.pose(&pose, transl)?;
+    let mut files = Vec::new();
     if let (Some(output), Some(glb)) = (&args.output, glb) {
-        write_output(&avatar, &posed, args.pose.is_rest(), glb.then_some(motion.as_ref()), output)?;
-        tracing::info!("wrote {} ({} vertices)", output.display(), avatar.canonical.num_vertices());
+        files = mesh_files(&avatar, &posed, args.pose.is_rest(), glb.then_some(motion.as_ref()), output)?;
     }
+    let writing = |path: &Path| format!("writing {}", path.display());
     if let Some(path) = &args.gaussians {
         let scene = export::gaussian_scene(&avatar, &posed.gaussians)?;
-        scene.write_ply(path)?;
-        tracing::info!("wrote {} ({} Gaussians, SH degree {})", path.display(), scene.len(), scene.sh_degree);
+        files.push((path.clone(), Made::Bytes(scene.ply_bytes(&[]).with_context(|| writing(path))?)));
     }
     if let Some(path) = &args.skinned_gaussians {
-        let bytes = export::skinned_gaussians_ply(&avatar, &canonical_pose(&avatar)?)?;
-        mannequin_io::write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
-        tracing::info!("wrote {} ({} Gaussians with their skinning)", path.display(), avatar.num_gaussians());
+        let bytes = export::skinned_gaussians_ply(&avatar, &canonical_pose(&avatar)?)
+            .with_context(|| writing(path))?;
+        files.push((path.clone(), Made::Bytes(bytes)));
+    }
+    for (path, made) in files {
+        match made {
+            Made::Mesh(mesh) => write_mesh(&path, &mesh)?,
+            Made::Bytes(bytes) => {
+                mannequin_io::write_atomic(&path, &bytes).with_context(|| writing(&path))?
+            }
+        }
+        tracing::info!("wrote {}", path.display());
     }
     Ok(())
 }

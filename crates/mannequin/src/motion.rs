@@ -50,19 +50,37 @@ pub struct Clip {
     pub max_frames: Option<usize>,
 }
 
+/// Keeps the first `n` frames of `motion` (all, if it has fewer).
+fn first_frames(motion: &mut Motion, n: usize) {
+    let n = n.min(motion.num_frames());
+    motion.poses.truncate(n * 3 * motion.joints);
+    motion.trans.truncate(3 * n);
+}
+
 impl Clip {
+    /// The clip, cut to --max-frames before it is resampled, so a long motion at a high --fps
+    /// costs only the frames played.
     pub fn load(&self) -> Result<Motion> {
         let mut motion = Motion::read(&self.motion)?;
-        if let Some(fps) = self.fps {
-            motion = motion.resample(fps)?;
-        }
         if let Some(n) = self.max_frames {
             if n == 0 {
                 bail!("--max-frames must be at least 1");
             }
-            let n = n.min(motion.num_frames());
-            motion.poses.truncate(n * 3 * motion.joints);
-            motion.trans.truncate(3 * n);
+            // The source frames the first n resampled ones interpolate between, and one spare.
+            let source = match self.fps {
+                Some(fps) if fps.is_finite() && fps > 0.0 => {
+                    (((n - 1) as f64 * f64::from(motion.fps) / f64::from(fps)).ceil() as usize)
+                        .saturating_add(2)
+                }
+                _ => n,
+            };
+            first_frames(&mut motion, source);
+        }
+        if let Some(fps) = self.fps {
+            motion = motion.resample(fps)?;
+        }
+        if let Some(n) = self.max_frames {
+            first_frames(&mut motion, n);
         }
         Ok(motion)
     }

@@ -5,14 +5,14 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
+use mannequin_avatar::canonical::MAX_SUBDIVISIONS;
 use mannequin_avatar::trainer::checkpoint_path;
 use mannequin_avatar::{
-    Avatar, AvatarConfig, AvatarError, Canonical, GarmentRecord, Method, SkirtMode, TrainOptions, Trainer,
-    TrainingRun, load_views,
+    Avatar, AvatarConfig, AvatarError, Canonical, Checkpoint, GarmentRecord, Method, SkirtMode, TrainOptions,
+    Trainer, TrainingRun, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::{Dataset, Fingerprint};
-use mannequin_io::Npz;
 
 use crate::compute::Compute;
 use crate::garment_layers;
@@ -36,9 +36,9 @@ pub struct Args {
     /// Body model the dataset's poses drive: default, default-lod1, or an SMPL-family .npz.
     #[arg(long, default_value = "default")]
     pub body: String,
-    /// Midpoint subdivisions of the body template (each quadruples the faces).
-    #[arg(long, default_value_t = 0)]
-    pub subdivide: usize,
+    /// Midpoint subdivisions of the body template (each quadruples the faces), at most 3.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_SUBDIVISIONS as u64))]
+    pub subdivide: u64,
     /// Divide the images' resolution by this factor.
     #[arg(long, default_value_t = 1)]
     pub downscale: usize,
@@ -60,7 +60,7 @@ pub struct Args {
     pub antialiased: bool,
     /// Screen-filter variance in px² added to every Gaussian's footprint (3DGS uses 0.3; larger
     /// values widen silhouettes and shrink the fitted mesh).
-    #[arg(long, default_value_t = mannequin_avatar::AVATAR_DILATION)]
+    #[arg(long, default_value_t = mannequin_avatar::AVATAR_DILATION, value_parser = parse_dilation)]
     pub dilation: f64,
     /// Skirt layer over the body: auto (where the masks fill the gap between the legs below
     /// mid-thigh) or off.
@@ -83,9 +83,17 @@ pub struct Args {
     pub restart: bool,
 }
 
+/// A screen-filter variance: a finite number of px², at least 0.
+fn parse_dilation(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(d) if d.is_finite() && d >= 0.0 => Ok(d),
+        _ => Err(format!("'{text}': expected a finite variance >= 0 (px²)")),
+    }
+}
+
 fn avatar_config(args: &Args) -> AvatarConfig {
     let mut config = AvatarConfig::new(args.method, args.seed);
-    config.subdivisions = args.subdivide;
+    config.subdivisions = args.subdivide as usize;
     config.antialiased = args.antialiased;
     config.dilation = args.dilation;
     if args.method == Method::Tavatar {
@@ -150,15 +158,14 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
         options: train_options(args),
     };
     let checkpoint = checkpoint_path(&args.out);
-    let resume = !args.restart && checkpoint.exists();
-    if resume {
+    let resume = if !args.restart && checkpoint.exists() {
         // Whether a skirt layer is added is decided from the views, not loaded yet; it follows
         // from the data, body, subdivisions and skirt mode compared here.
-        Npz::read(&checkpoint)
-            .map_err(AvatarError::from)
-            .and_then(|npz| record.check(&npz, &["avatar.skirt_layer"]))
-            .map_err(start_over)?;
-    } else if args.restart && checkpoint.exists() {
+        Some(Checkpoint::open(&checkpoint, &record, &["avatar.skirt_layer"]).map_err(start_over)?)
+    } else {
+        None
+    };
+    if args.restart && checkpoint.exists() {
         // Gone before anything new is written, so a restart stopped before its first
         // checkpoint starts over again instead of resuming the old run.
         std::fs::remove_file(&checkpoint).with_context(|| format!("removing {}", checkpoint.display()))?;
@@ -180,7 +187,7 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
         &args.out,
     )?;
     let (canonical, skirt_layer) =
-        Canonical::for_subject(&model, &split.poses.betas, args.subdivide, &views, skirt, &layers)?;
+        Canonical::for_subject(&model, &split.poses.betas, args.subdivide as usize, &views, skirt, &layers)?;
     if let Some(layer) = &skirt_layer {
         tracing::info!("the masks show a skirt: adding {layer} (--skirt off trains without)");
     }
@@ -188,12 +195,10 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
     let device = args.device.device()?.autodiff();
     let avatar = Avatar::new(record.avatar.clone(), canonical, &device)?;
     let mut trainer = Trainer::new(avatar, views, record.options.clone())?;
-    if resume {
-        trainer.resume(&checkpoint, &record).map_err(start_over)?;
+    // Nothing is written before the first checkpoint: a run that fails leaves no untrained model.
+    if let Some(saved) = &resume {
+        trainer.resume(saved, &record).map_err(start_over)?;
         tracing::info!("resuming from {} at iteration {}", checkpoint.display(), trainer.iteration);
-    } else {
-        // The model folder is usable (loadable) from the start.
-        trainer.avatar.save(&args.out)?;
     }
     tracing::info!(
         "{} Gaussians on {} vertices, {} views, {} iterations",
@@ -240,10 +245,13 @@ pub fn train(mut trainer: Trainer, record: &TrainingRun, args: &Args) -> Result<
     }
     progress.finish_and_clear();
     trainer.avatar.save(&args.out)?;
-    tracing::info!(
-        "wrote {} (running PSNR {:.2} dB on training crops)",
-        args.out.display(),
-        running_psnr.unwrap_or(f64::NAN)
-    );
+    match running_psnr {
+        Some(p) => tracing::info!("wrote {} (running PSNR {p:.2} dB on training crops)", args.out.display()),
+        None => tracing::info!(
+            "wrote {} (the checkpoint had finished all {} iterations)",
+            args.out.display(),
+            args.iters
+        ),
+    }
     Ok(())
 }

@@ -391,3 +391,102 @@ fn eval_scores_each_test_set_afresh_in_one_layout() {
     one_line_error(&mannequin(&["eval", "--pred", s(&pred), "--gt", s(&data)]), &["image_0009.png"]);
     std::fs::remove_dir_all(out).unwrap();
 }
+
+/// A copy of the trained model in `dir`: its avatar files, not its checkpoint.
+fn model_copy(dir: &Path) -> PathBuf {
+    let copy = dir.join("model");
+    std::fs::create_dir_all(&copy).unwrap();
+    for file in ["avatar.json", "avatar.npz"] {
+        std::fs::copy(model().join(file), copy.join(file)).unwrap();
+    }
+    copy
+}
+
+/// [`model_copy`] with `key` of `avatar.npz` replaced by `array`.
+fn model_with(dir: &Path, key: &str, array: mannequin_io::NpyArray) -> PathBuf {
+    let copy = model_copy(dir);
+    let npz = mannequin_io::Npz::read(model().join("avatar.npz")).unwrap();
+    let mut w = mannequin_io::NpzWriter::new();
+    for k in npz.keys().filter(|&k| k != key) {
+        w.add(k, npz.get(k).unwrap().clone());
+    }
+    w.add(key, array);
+    w.write(copy.join("avatar.npz")).unwrap();
+    copy
+}
+
+/// An avatar with a non-finite or meaningless value is refused when it loads, naming the file
+/// and the array: `render` once blamed the camera for it, and `export --gaussians` wrote a `.ply`
+/// of NaN.
+#[test]
+fn a_corrupt_avatar_is_refused_by_field() {
+    use mannequin_io::NpyArray;
+    let out = scratch("avatar-cli-corrupt");
+    let npz = mannequin_io::Npz::read(model().join("avatar.npz")).unwrap();
+    let spoiled = |key: &str, i: usize, value: f32| {
+        let a = npz.get(key).unwrap();
+        let mut v = a.to_f32().unwrap();
+        v[i] = value;
+        NpyArray::f32(a.shape.clone(), v)
+    };
+    for (key, array, expected) in [
+        ("vertices", spoiled("vertices", 7, f32::NAN), "element 7 is NaN"),
+        ("joints", spoiled("joints", 2, f32::INFINITY), "element 2 is inf"),
+        ("weights", spoiled("weights", 30, f32::NAN), "element 30 is NaN"),
+        ("offset_gate", spoiled("offset_gate", 4, 2.0), "element 4 is 2: expected 0–1"),
+        ("posedirs", NpyArray::f32(vec![5, 3], vec![0.0; 15]), "expected shape"),
+    ] {
+        let model = model_with(&out.join(key), key, array);
+        let (png, ply) = (out.join("a.png"), out.join("g.ply"));
+        for args in [
+            &["render", "--avatar", s(&model), "-o", s(&png)][..],
+            &["export", "--avatar", s(&model), "--gaussians", s(&ply)],
+        ] {
+            one_line_error(&mannequin(args), &["avatar.npz", &format!("'{key}'"), expected]);
+        }
+        assert!(!png.exists() && !ply.exists(), "{key}: an output was written");
+    }
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// An `eval` that fails writes nothing: its predictions replace an earlier run's only once every
+/// set is scored, and the geometry scores are numbers or an error, never null.
+#[test]
+fn a_failing_eval_leaves_the_model_folder_as_it_was() {
+    let out = scratch("avatar-cli-eval-fails");
+    let copy = model_copy(&out);
+    let earlier = copy.join("eval/novel_view/images/image_0000.png");
+    std::fs::create_dir_all(earlier.parent().unwrap()).unwrap();
+    std::fs::write(&earlier, b"earlier").unwrap();
+    // The second set fails after the first is rendered and scored.
+    let data = out.join("data");
+    ok(Command::new("cp").arg("-r").arg(model().parent().unwrap().join("data")).arg(&data).output().unwrap());
+    std::fs::write(data.join("test/novel_pose/splits.json"), b"{").unwrap();
+    let before: Vec<PathBuf> = walk_files(&copy);
+    one_line_error(
+        &mannequin(&["eval", "--avatar", s(&copy), "--data", s(&data), "--samples", "500"]),
+        &["novel_pose", "splits.json"],
+    );
+    assert_eq!(walk_files(&copy), before, "the failed eval changed the model folder");
+    assert_eq!(std::fs::read(&earlier).unwrap(), b"earlier");
+    usage_error(
+        &mannequin(&["eval", "--avatar", s(&copy), "--data", s(&data), "--samples", "0"]),
+        &["--samples"],
+    );
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// Every file under `dir`, sorted.
+fn walk_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files.extend(walk_files(&path));
+        } else {
+            files.push(path);
+        }
+    }
+    files.sort();
+    files
+}

@@ -1,6 +1,7 @@
 //! `train` checkpoints as a user meets them, on a tiny synthetic subject: a run killed mid-way
 //! and started again ends bit-identical to an uninterrupted one, a resume with other settings is
-//! refused in one line before any training, and `--restart` drops the old checkpoint at once.
+//! refused in one line before any training, and so is a checkpoint edited outside the run,
+//! `--restart` drops the old checkpoint at once, and a run that fails leaves no model.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -148,11 +149,92 @@ fn other_settings_are_refused_and_restart_drops_the_checkpoint_first() {
     }
 
     // A restart stopped before its first checkpoint has already dropped the old one, so the
-    // next plain run starts over instead of resuming the old run.
+    // next plain run starts over instead of resuming the old run; the old model stays until
+    // the new one is finished.
     let log = dir.join("restart.log");
     let restart = train(&out, &["--restart", "--iters", "1000", "--checkpoint-every", "1000"]);
-    let fresh_model = || std::fs::read(out.join("avatar.npz")).is_ok_and(|b| b != before[1]);
-    Running::start(restart, &log).kill_when(&log, fresh_model);
+    let training = || std::fs::read_to_string(&log).is_ok_and(|l| l.contains("Gaussians on"));
+    Running::start(restart, &log).kill_when(&log, training);
     assert!(!out.join("checkpoint.npz").exists(), "--restart left the old checkpoint");
+    assert!(std::fs::read(out.join("avatar.npz")).unwrap() == before[1], "the old model was replaced");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `checkpoint` rewritten with `key` replaced by `array`, every other array as it was.
+fn edit_checkpoint(checkpoint: &Path, key: &str, array: mannequin_io::NpyArray) {
+    let npz = Npz::read(checkpoint).unwrap();
+    let mut w = mannequin_io::NpzWriter::uncompressed();
+    for k in npz.keys().filter(|&k| k != key) {
+        w.add(k, npz.get(k).unwrap().clone());
+    }
+    w.add(key, array);
+    w.write(checkpoint).unwrap();
+}
+
+/// A checkpoint edited by hand once resumed into a NaN avatar ("running PSNR NaN dB"): a
+/// negative Adam second moment, or an iteration before the run or past its end, is refused in
+/// one line naming the file and the field, and the model folder is left as it was.
+#[test]
+fn a_checkpoint_outside_the_run_is_refused_by_field() {
+    use mannequin_io::NpyArray;
+    let dir = scratch("train-resume-corrupt");
+    let out = dir.join("model");
+    let flags = ["--iters", "2", "--checkpoint-every", "1"];
+    ok(train(&out, &flags).output().unwrap());
+    let checkpoint = out.join("checkpoint.npz");
+    let good = std::fs::read(&checkpoint).unwrap();
+    let model = std::fs::read(out.join("avatar.npz")).unwrap();
+    let v = Npz::read(&checkpoint).unwrap().keys().find(|k| k.starts_with("adam_v/")).unwrap().to_string();
+    let moment = Npz::read(&checkpoint).unwrap().get(&v).unwrap().clone();
+    let mut negative = moment.to_f32().unwrap();
+    negative[1] = -0.25;
+    for (key, array, expected) in [
+        (v.as_str(), NpyArray::f32(moment.shape.clone(), negative), "element 1 is -0.25: expected 0–inf"),
+        (
+            "iteration",
+            NpyArray::i64(vec![1], vec![-5]),
+            "expected an iteration from 0 to 2 (the run's --iters), found -5",
+        ),
+        ("iteration", NpyArray::i64(vec![1], vec![1 << 62]), "found 4611686018427387904"),
+        ("iteration", NpyArray::i64(vec![1], vec![3]), "found 3"),
+    ] {
+        std::fs::write(&checkpoint, &good).unwrap();
+        edit_checkpoint(&checkpoint, key, array);
+        let edited = std::fs::read(&checkpoint).unwrap();
+        let line = error_line(&train(&out, &flags).output().unwrap());
+        for needle in ["checkpoint.npz", &format!("'{key}'"), expected, "--restart"] {
+            assert!(line.contains(needle), "'{needle}' not in: {line}");
+        }
+        assert!(std::fs::read(&checkpoint).unwrap() == edited, "{key}: the checkpoint changed");
+        assert!(std::fs::read(out.join("avatar.npz")).unwrap() == model, "{key}: avatar.npz changed");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A run that fails writes no model: a folder holding `avatar.npz` is a trained avatar, never an
+/// untrained one that `render` would go on to use.
+#[test]
+fn a_failing_run_leaves_no_model() {
+    let dir = scratch("train-resume-nan-pose");
+    let subject = dir.join("subject");
+    ok(Command::new("cp").arg("-r").arg(data()).arg(&subject).output().unwrap());
+    let poses = subject.join("poses/anim_nerf_train.npz");
+    let npz = Npz::read(&poses).unwrap();
+    let mut body = npz.get("body_pose").unwrap().clone();
+    if let NpyData::F32(v) = &mut body.data {
+        v.iter_mut().step_by(69).for_each(|x| *x = f32::NAN);
+    }
+    let mut w = mannequin_io::NpzWriter::new();
+    for k in npz.keys().filter(|&k| k != "body_pose") {
+        w.add(k, npz.get(k).unwrap().clone());
+    }
+    w.add("body_pose", body);
+    w.write(&poses).unwrap();
+    let out = dir.join("model");
+    let base = ["train", "--data", s(&subject), "--out", s(&out), "--body", "default-lod1"];
+    let o = command(&[&base[..], &["--iters", "4", "--checkpoint-every", "4"]].concat()).output().unwrap();
+    let line = error_line(&o);
+    assert!(line.contains("not finite") || line.contains("NaN"), "{line}");
+    assert!(!out.exists(), "a failed run left {:?}", std::fs::read_dir(&out).map(|d| d.count()));
     std::fs::remove_dir_all(dir).unwrap();
 }

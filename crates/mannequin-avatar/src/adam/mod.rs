@@ -8,13 +8,11 @@ mod flex;
 mod fused;
 mod kernels;
 
-use std::path::Path;
-
 use burn::tensor::{Gradients, Tensor};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
-use crate::params::{Param, to_npy};
+use crate::params::{ANY_FINITE, Param, to_npy};
 use fused::Coefficients;
 
 /// First and second moment estimates per parameter, on the parameters' inner device.
@@ -58,15 +56,18 @@ impl Adam {
         }
     }
 
-    /// Restores moments saved by [`Adam::save`] for the same parameters.
-    pub fn load(params: &[Param], npz: &Npz, path: &Path) -> Result<Self, AvatarError> {
-        let (_, step) = npz.f64_with_shape("adam_step", &[Some(1)])?;
+    /// Restores moments saved by [`Adam::save`] for the same parameters, `step` steps in (the
+    /// caller checks it against the run). Second moments are averages of squares: a negative one
+    /// is refused, as its square root would turn the next update into NaN.
+    pub fn load(params: &[Param], npz: &Npz, step: usize) -> Result<Self, AvatarError> {
         let mut adam = Self::new(params);
-        adam.step = step[0] as usize;
+        adam.step = step;
         for (k, p) in params.iter().enumerate() {
-            for (prefix, slot) in [("adam_m/", &mut adam.m[k]), ("adam_v/", &mut adam.v[k])] {
+            for (prefix, slot, allowed) in
+                [("adam_m/", &mut adam.m[k], ANY_FINITE), ("adam_v/", &mut adam.v[k], 0.0..=f64::INFINITY)]
+            {
                 let mut moment = Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
-                moment.load(npz, prefix, path)?;
+                moment.load(npz, prefix, allowed)?;
                 // Checkpoints store f32; the op wants the parameter's dtype.
                 *slot = moment.value.inner().cast(p.value.dtype());
             }
