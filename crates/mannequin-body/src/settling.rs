@@ -6,6 +6,14 @@ use mannequin_mesh::points;
 
 use crate::{BodyError, BodyModel, Motion, ShapedBody, pose_frames};
 
+/// Longest settling period (s): a garment hangs still within a second or two, and every second
+/// costs a simulated frame per frame of the motion's rate.
+pub const MAX_SETTLE_SECONDS: f32 = 10.0;
+
+/// Most settling frames, whatever the motion's frame rate: ten seconds at 120 fps, the highest
+/// rate motion capture records at.
+pub const MAX_SETTLE_FRAMES: usize = 1200;
+
 /// The body's pose schedule: `settle` frames (at least one) from rest into the motion's first
 /// frame, then the motion. Frame 0 is the rest pose.
 #[derive(Debug, Clone)]
@@ -20,8 +28,8 @@ pub struct Settling {
 impl Settling {
     pub fn new(model: &BodyModel, motion: &Motion, settle_seconds: f32) -> Result<Self, BodyError> {
         let joints = model.num_joints();
+        let settle = Self::settle_frames(settle_seconds, motion.fps)?;
         let poses = motion.poses_for(model)?;
-        let settle = ((settle_seconds.max(0.0) * motion.fps).round() as usize).max(1);
         let hold = settle / 2;
         let mut all_poses = Vec::with_capacity((settle + motion.num_frames()) * 3 * joints);
         let mut all_trans = Vec::new();
@@ -35,6 +43,27 @@ impl Settling {
         all_poses.extend_from_slice(&poses);
         all_trans.extend_from_slice(&motion.trans);
         Ok(Self { settle, poses: all_poses, trans: all_trans, joints })
+    }
+
+    /// Frames of settling for `settle_seconds` at `fps` (at least one), refused past
+    /// [`MAX_SETTLE_SECONDS`] or [`MAX_SETTLE_FRAMES`]: known before anything is allocated.
+    pub fn settle_frames(settle_seconds: f32, fps: f32) -> Result<usize, BodyError> {
+        if !(0.0..=MAX_SETTLE_SECONDS).contains(&settle_seconds) {
+            return Err(BodyError::input(
+                "settle",
+                format!("{settle_seconds} s; expected 0 to {MAX_SETTLE_SECONDS} seconds"),
+            ));
+        }
+        let frames = (f64::from(settle_seconds) * f64::from(fps)).round();
+        if !frames.is_finite() || frames > MAX_SETTLE_FRAMES as f64 {
+            return Err(BodyError::input(
+                "settle",
+                format!(
+                    "{settle_seconds} s at {fps} fps is {frames} frames; expected at most {MAX_SETTLE_FRAMES}"
+                ),
+            ));
+        }
+        Ok((frames as usize).max(1))
     }
 
     /// Frames in all, settling included.
@@ -80,5 +109,21 @@ mod tests {
             assert!((p - w * q).abs() <= 1e-6 * q.abs().max(1.0), "{p} vs {}", w * q);
         }
         assert_eq!(s.pose(12).0, &first[..3 * model.num_joints()], "the motion follows unchanged");
+    }
+
+    /// Issue 42: `--settle inf` grew to 24 GB; a settling period past the limits, or not a
+    /// number, is refused before anything is allocated.
+    #[test]
+    fn settling_past_its_limits_is_refused() {
+        let model = BodyModel::default_body_lod1();
+        let motion = Motion::walk_cycle(0.2, 30.0);
+        for bad in [f32::INFINITY, f32::NAN, -1.0, 1e5, MAX_SETTLE_SECONDS + 0.1] {
+            let e = Settling::new(&model, &motion, bad).unwrap_err().to_string();
+            assert!(e.starts_with("settle: ") && e.contains("expected 0 to 10 seconds"), "{e}");
+        }
+        let e = Settling::settle_frames(10.0, 1e6).unwrap_err().to_string();
+        assert!(e.contains("expected at most 1200"), "{e}");
+        assert_eq!(Settling::settle_frames(0.0, 30.0).unwrap(), 1);
+        assert_eq!(Settling::settle_frames(MAX_SETTLE_SECONDS, 120.0).unwrap(), MAX_SETTLE_FRAMES);
     }
 }
