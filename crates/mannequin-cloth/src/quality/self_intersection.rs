@@ -7,6 +7,11 @@ use std::collections::HashMap;
 
 use super::triangle_intersection::{Point, triangles_intersect};
 
+/// A box spanning more grid cells than this along an axis is tested against every other box
+/// rather than listed in the cells it covers: one triangle stretched across the scene (a particle
+/// flung far) would otherwise be listed in the cube of its span, billions of cells (issue 42).
+const MAX_SPAN_CELLS: i64 = 16;
+
 /// The number of intersecting pairs of triangles with no vertex in common. Faces with an index out
 /// of range are ignored.
 pub fn self_intersecting_pairs(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> usize {
@@ -52,12 +57,20 @@ fn intersecting_pairs(
             (lo, hi)
         })
         .collect();
-    let extent: f64 = boxes.iter().map(|(lo, hi)| (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)).sum();
-    let cell = (extent / boxes.len() as f64).max(f64::MIN_POSITIVE);
+    // The median box's size: a few triangles stretched across the scene do not coarsen it.
+    let mut extents: Vec<f64> =
+        boxes.iter().map(|(lo, hi)| (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)).collect();
+    extents.sort_by(f64::total_cmp);
+    let cell = extents[extents.len() / 2].max(f64::MIN_POSITIVE);
     let key = |p: Point| p.map(|x| (x / cell).floor() as i64);
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut large = vec![false; boxes.len()];
     for (k, (lo, hi)) in boxes.iter().enumerate() {
         let (a, b) = (key(*lo), key(*hi));
+        if (0..3).any(|d| b[d].saturating_sub(a[d]) >= MAX_SPAN_CELLS) {
+            large[k] = true;
+            continue;
+        }
         for x in a[0]..=b[0] {
             for y in a[1]..=b[1] {
                 for z in a[2]..=b[2] {
@@ -66,25 +79,30 @@ fn intersecting_pairs(
             }
         }
     }
+    let overlap = |i: usize, j: usize| {
+        let ((lo_i, hi_i), (lo_j, hi_j)) = (boxes[i], boxes[j]);
+        !(0..3).any(|k| lo_i[k] > hi_j[k] || lo_j[k] > hi_i[k])
+    };
+    let intersect = |i: usize, j: usize| {
+        let ((i, fi), (j, fj)) = (faces[i], faces[j]);
+        counts(i, j) && !fi.iter().any(|v| fj.contains(v)) && triangles_intersect(corners(fi), corners(fj))
+    };
     let mut count = 0;
     for (cell_key, members) in &grid {
         for (n, &i) in members.iter().enumerate() {
             for &j in &members[n + 1..] {
-                let ((lo_i, hi_i), (lo_j, hi_j)) = (boxes[i as usize], boxes[j as usize]);
-                if (0..3).any(|k| lo_i[k] > hi_j[k] || lo_j[k] > hi_i[k]) {
+                let (i, j) = (i as usize, j as usize);
+                if !overlap(i, j) || key([0, 1, 2].map(|k| boxes[i].0[k].max(boxes[j].0[k]))) != *cell_key {
                     continue;
                 }
-                if key([0, 1, 2].map(|k| lo_i[k].max(lo_j[k]))) != *cell_key {
-                    continue;
-                }
-                let ((i, fi), (j, fj)) = (faces[i as usize], faces[j as usize]);
-                if !counts(i, j) || fi.iter().any(|v| fj.contains(v)) {
-                    continue;
-                }
-                if triangles_intersect(corners(fi), corners(fj)) {
-                    count += 1;
-                }
+                count += usize::from(intersect(i, j));
             }
+        }
+    }
+    // Each large box against every other (a pair of large ones once).
+    for i in (0..boxes.len()).filter(|&i| large[i]) {
+        for j in (0..boxes.len()).filter(|&j| j != i && !(large[j] && j < i)) {
+            count += usize::from(overlap(i, j) && intersect(i, j));
         }
     }
     count
@@ -155,6 +173,26 @@ mod tests {
             .count();
         assert!(brute > 0 && self_intersecting_pairs(&a, &a_faces) > 0);
         assert_eq!(crossing_pairs(&a, &a_faces, &b, &b_faces), brute);
+    }
+
+    /// Issue 42: a particle flung 1e30 m away stretched its triangles across billions of grid
+    /// cells and the count hung. A sliver from under the sheet through it to there is counted,
+    /// as testing every pair counts it.
+    #[test]
+    fn a_flung_particle_neither_hangs_nor_hides_a_crossing() {
+        let (mut positions, mut faces) = (Vec::new(), Vec::new());
+        square([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 6, &mut positions, &mut faces);
+        let base = positions.len() as u32;
+        positions.extend([[0.3, 0.3, -0.5], [0.32, 0.3, -0.5], [1e30, 1e30, 1e30]]);
+        faces.push([base, base + 1, base + 2]);
+        let corners = |f: [u32; 3]| f.map(|k| positions[k as usize].map(f64::from));
+        let brute = (0..faces.len())
+            .flat_map(|i| (i + 1..faces.len()).map(move |j| (i, j)))
+            .filter(|&(i, j)| !faces[i].iter().any(|v| faces[j].contains(v)))
+            .filter(|&(i, j)| triangles_intersect(corners(faces[i]), corners(faces[j])))
+            .count();
+        assert!(brute > 0);
+        assert_eq!(self_intersecting_pairs(&positions, &faces), brute);
     }
 
     #[test]
