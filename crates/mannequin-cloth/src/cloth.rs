@@ -5,11 +5,10 @@ use mannequin_mesh::{TriMesh, UvLayout};
 
 use crate::bending::BendingConstraints;
 use crate::error::ClothError;
-use crate::garment_check::check_garment;
+use crate::garment_check::{check_pins, checked_topology};
 use crate::material::Material;
 use crate::rest_shape::RestShape;
 use crate::stretch::StretchConstraints;
-use crate::topology::topology;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cloth {
@@ -27,7 +26,7 @@ impl Cloth {
     /// `material`, with the vertices `pins` held in place.
     ///
     /// Each triangle gives a third of its mass (area × density) to each of its vertices. Pinned
-    /// vertices, and vertices no triangle uses, get inverse mass 0: they never move.
+    /// vertices get inverse mass 0: they never move.
     pub fn new(mesh: &TriMesh, material: &Material, pins: &[u32]) -> Result<Cloth, ClothError> {
         Self::resting(mesh, RestShape::of_mesh(mesh), material, pins)
     }
@@ -50,8 +49,8 @@ impl Cloth {
         pins: &[u32],
     ) -> Result<Cloth, ClothError> {
         material.validate()?;
-        check_garment(mesh, pins)?;
-        let topology = topology(&mesh.faces)?;
+        let topology = checked_topology(mesh)?;
+        check_pins(pins, mesh.positions.len())?;
         let n = mesh.positions.len();
         let mass = rest.masses(&mesh.faces, n, material.density);
         let mut inverse_mass: Vec<f32> = mass.iter().map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 }).collect();

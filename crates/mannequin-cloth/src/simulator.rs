@@ -219,20 +219,7 @@ impl Simulator {
 
     /// Continues from `state`, as saved by [`Simulator::state`] from a simulator of the same cloth.
     pub fn restore(&mut self, state: ClothState) -> Result<(), ClothError> {
-        let n = self.positions.len();
-        for (field, values) in
-            [("state.positions", &state.positions), ("state.velocities", &state.velocities)]
-        {
-            if values.len() != n {
-                return Err(ClothError::invalid(
-                    field,
-                    format!("{} entries for {n} particles", values.len()),
-                ));
-            }
-            if let Some(i) = values.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-                return Err(ClothError::invalid(field, format!("entry {i} is not finite")));
-            }
-        }
+        state.check(self.positions.len())?;
         self.positions = state.positions;
         self.velocities = state.velocities;
         Ok(())
