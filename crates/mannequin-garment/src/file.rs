@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use mannequin_cloth::{MAX_GARMENT_VERTICES, check_garment, check_positions};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::{SurfacePoint, TriMesh, UvLayout, points};
 
@@ -38,6 +39,16 @@ pub fn write_garment(path: &Path, g: &Garment) -> Result<(), GarmentError> {
     Ok(())
 }
 
+/// Farthest a garment vertex may hang off the body point it is bound to (m): a flared hem
+/// stands some 30 cm off the legs; a metre off is no garment worn on this body.
+pub const MAX_OFFSET: f32 = 1.0;
+
+/// How far a barycentric weight may stray outside [0, 1], or their sum from 1: float rounding
+/// of a closest point, not a point off its face.
+const BARY_TOLERANCE: f32 = 1e-3;
+
+/// Reads a `.garment` file, refusing one that `write_garment` would not have written from a
+/// template that can be simulated: every refusal names the file and the field.
 pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
     let npz = Npz::read(path)?;
     let file_error = |reason: String| GarmentError::File { path: path.display().to_string(), reason };
@@ -47,7 +58,7 @@ pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
     }
     let recipe: Recipe = serde_json::from_str(npz.text("recipe")?)
         .map_err(|e| file_error(format!("recipe: {e}; expected the recipe as JSON")))?;
-    recipe.fit.validate().map_err(|e| file_error(format!("recipe: {e}")))?;
+    recipe.validate().map_err(|e| file_error(format!("recipe: {e}")))?;
     let floats = |key: &str, shape: &[Option<usize>]| -> Result<(Vec<usize>, Vec<f32>), GarmentError> {
         let (shape, v) = npz.f64_with_shape(key, shape)?;
         if v.iter().any(|x| !x.is_finite()) {
@@ -57,6 +68,11 @@ pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
     };
     let (shape, positions) = floats("positions", &[None, Some(3)])?;
     let n = shape[0];
+    if n > MAX_GARMENT_VERTICES {
+        return Err(npz
+            .field_error("positions", format!("{n} rows; expected at most {MAX_GARMENT_VERTICES}"))
+            .into());
+    }
     let triples = |key: &str, count: usize| -> Result<Vec<[u32; 3]>, GarmentError> {
         let (_, v) = npz.f64_with_shape(key, &[None, Some(3)])?;
         if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i >= count as f64 || i.fract() != 0.0) {
@@ -68,6 +84,9 @@ pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
     };
     let faces = triples("faces", n)?;
     let mut mesh = TriMesh::new(points(&positions), faces);
+    check_positions("positions", &mesh.positions)
+        .and_then(|()| check_garment(&mesh))
+        .map_err(|e| file_error(e.to_string()))?;
     if npz.contains("uv") {
         let (shape, coords) = floats("uv", &[None, Some(2)])?;
         let uv_faces = triples("uv_faces", shape[0])?;
@@ -96,11 +115,31 @@ pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
             .into());
     }
     let (_, bary) = floats("body_bary", &[Some(n), Some(3)])?;
+    let bary = points(&bary);
+    let off_face = |b: &[f32; 3]| {
+        b.iter().any(|&w| !(-BARY_TOLERANCE..=1.0 + BARY_TOLERANCE).contains(&w))
+            || (b.iter().sum::<f32>() - 1.0).abs() > BARY_TOLERANCE
+    };
+    if let Some(i) = bary.iter().position(off_face) {
+        return Err(npz
+            .field_error(
+                "body_bary",
+                format!("row {i} is {:?}; expected weights in [0, 1] summing to 1", bary[i]),
+            )
+            .into());
+    }
     let (_, offsets) = floats("offsets", &[Some(n), Some(3)])?;
-    let binding = body_faces
-        .iter()
-        .zip(points(&bary))
-        .map(|(&face, bary)| SurfacePoint { face: face as u32, bary })
-        .collect();
-    Ok(Garment { recipe, mesh, binding, offsets: points(&offsets) })
+    let offsets = points(&offsets);
+    let too_far = |d: &[f32; 3]| d.iter().map(|x| x * x).sum::<f32>() > MAX_OFFSET * MAX_OFFSET;
+    if let Some(i) = offsets.iter().position(too_far) {
+        return Err(npz
+            .field_error(
+                "offsets",
+                format!("row {i} is {:?}; expected at most {MAX_OFFSET} m long", offsets[i]),
+            )
+            .into());
+    }
+    let binding =
+        body_faces.iter().zip(bary).map(|(&face, bary)| SurfacePoint { face: face as u32, bary }).collect();
+    Ok(Garment { recipe, mesh, binding, offsets })
 }

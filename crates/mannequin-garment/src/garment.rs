@@ -4,10 +4,13 @@
 //! form of MGN's vertex selection), and D^g the offset from it.
 
 use glam::Vec3;
+use mannequin_body::BodyModel;
+use mannequin_cloth::{MATERIAL_NAMES, Material};
 use mannequin_mesh::{ClosestPoint, SurfacePoint, TriMesh, UvLayout};
 use serde::{Deserialize, Serialize};
 
 use crate::category::Category;
+use crate::error::GarmentError;
 use crate::fit::Fit;
 
 /// How the template was made: enough to make it again on another body model.
@@ -26,6 +29,50 @@ pub struct Recipe {
     /// The body model's vertex and face counts: a template is refused on another model.
     pub body_vertices: usize,
     pub body_faces: usize,
+}
+
+/// Target edge lengths a template is made at (m): under 3 mm the remesher makes millions of
+/// triangles of a coat; over 10 cm a sleeve is a few triangles round.
+pub const EDGE_LENGTH_RANGE: std::ops::RangeInclusive<f32> = 0.003..=0.1;
+
+impl Recipe {
+    /// Refuses what [`crate::make_garment`] never makes: a fit out of range, an edge length
+    /// outside [`EDGE_LENGTH_RANGE`], a material the cloth simulator does not know, shape
+    /// coefficients that are not numbers, or a body model with no faces.
+    pub fn validate(&self) -> Result<(), GarmentError> {
+        self.fit.validate()?;
+        check_edge_length(self.edge_length)?;
+        if Material::named(&self.material).is_err() {
+            return Err(GarmentError::invalid(
+                "material",
+                format!("unknown name {:?}; the materials are {}", self.material, MATERIAL_NAMES.join(", ")),
+            ));
+        }
+        if let Some(i) = self.betas.iter().position(|b| !b.is_finite()) {
+            return Err(GarmentError::invalid("betas", format!("coefficient {i} is {}", self.betas[i])));
+        }
+        if self.body_vertices < 3 || self.body_faces == 0 {
+            return Err(GarmentError::invalid(
+                "body_vertices",
+                format!(
+                    "{} vertices and {} faces; expected a body model's (at least 3 and 1)",
+                    self.body_vertices, self.body_faces
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Refuses an edge length outside [`EDGE_LENGTH_RANGE`].
+pub(crate) fn check_edge_length(edge_length: f32) -> Result<(), GarmentError> {
+    if EDGE_LENGTH_RANGE.contains(&edge_length) {
+        return Ok(());
+    }
+    Err(GarmentError::invalid(
+        "edge_length",
+        format!("{edge_length} m; expected {} to {} m", EDGE_LENGTH_RANGE.start(), EDGE_LENGTH_RANGE.end()),
+    ))
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -63,6 +110,27 @@ impl Garment {
             .zip(&self.offsets)
             .map(|(point, d)| (point.locate(body, body_faces) + Vec3::from(*d)).to_array())
             .collect()
+    }
+
+    /// Refuses a body model of another topology than the one the template was made on: its
+    /// binding (I^g) names that model's faces. Every use of a template on a body goes through here.
+    pub fn check_body(&self, model: &BodyModel) -> Result<(), GarmentError> {
+        let recipe = &self.recipe;
+        let faces = model.faces.len();
+        if recipe.body_vertices == model.num_vertices() && recipe.body_faces == faces {
+            return Ok(());
+        }
+        Err(GarmentError::invalid(
+            "body",
+            format!(
+                "the garment was made on '{}' ({} vertices, {} faces), this body has {} and {faces}: \
+                 make it again on this body",
+                recipe.body,
+                recipe.body_vertices,
+                recipe.body_faces,
+                model.num_vertices(),
+            ),
+        ))
     }
 
     pub fn vertex_count(&self) -> usize {

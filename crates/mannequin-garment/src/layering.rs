@@ -5,17 +5,23 @@
 //! Eq. 3.2 then carries to every body shape.
 
 use glam::Vec3;
+use mannequin_body::BodyModel;
 
+use crate::error::GarmentError;
 use crate::garment::Garment;
 
 impl Garment {
-    /// This garment worn over `inner` (all on the same body model, innermost first): wherever an
-    /// inner garment covers the body face a vertex hangs on, its offset grows to at least that
-    /// garment's offset there plus `gap`, along the same direction.
-    pub fn over(&self, inner: &[&Garment], gap: f32, body_faces: &[[u32; 3]]) -> Garment {
+    /// This garment worn over `inner` (innermost first), all on `model`: wherever an inner
+    /// garment covers the body face a vertex hangs on, its offset grows to at least that
+    /// garment's offset there plus `gap`, along the same direction. A garment made on a model of
+    /// another topology is refused.
+    pub fn over(&self, inner: &[&Garment], gap: f32, model: &BodyModel) -> Result<Garment, GarmentError> {
+        for g in inner.iter().copied().chain([self]) {
+            g.check_body(model)?;
+        }
+        let body_faces = &model.faces;
         // Per body vertex, the largest offset of any inner garment hanging on a face around it.
-        let body_vertices = body_faces.iter().flatten().map(|&v| v as usize + 1).max().unwrap_or(0);
-        let mut cover = vec![0.0f32; body_vertices];
+        let mut cover = vec![0.0f32; model.num_vertices()];
         for g in inner {
             for (point, d) in g.binding.iter().zip(&g.offsets) {
                 let length = Vec3::from(*d).length();
@@ -38,7 +44,7 @@ impl Garment {
                 (d.normalize_or_zero() * (under + gap)).to_array()
             })
             .collect();
-        Garment { offsets, ..self.clone() }
+        Ok(Garment { offsets, ..self.clone() })
     }
 }
 
@@ -48,7 +54,7 @@ mod tests {
     use crate::{Category, Fit, Recipe};
     use mannequin_mesh::{SurfacePoint, TriMesh};
 
-    fn hanging(faces_hung: &[u32], offset: f32) -> Garment {
+    fn hanging(model: &BodyModel, faces_hung: &[u32], offset: f32) -> Garment {
         let recipe = Recipe {
             category: Category::Tshirt,
             fit: Fit::size("M").unwrap(),
@@ -56,8 +62,8 @@ mod tests {
             material: "cotton".into(),
             body: "test".into(),
             betas: vec![],
-            body_vertices: 4,
-            body_faces: 2,
+            body_vertices: model.num_vertices(),
+            body_faces: model.faces.len(),
         };
         let n = faces_hung.len();
         Garment {
@@ -68,20 +74,41 @@ mod tests {
         }
     }
 
-    /// Two body faces sharing an edge, an inner garment on the first 2 cm out: an outer vertex on
-    /// either face (they share corners) moves to 2 cm + gap; one already farther keeps its place;
-    /// on a body far from the inner garment's faces nothing moves.
+    /// An inner garment on a body face 2 cm out: an outer vertex on that face or on one sharing a
+    /// corner with it moves to 2 cm + gap; one already farther keeps its place; one on a face
+    /// away from it does not move.
     #[test]
     fn outer_offsets_clear_the_inner_garment() {
-        let body_faces = [[0, 1, 2], [0, 2, 3], [4, 5, 6]];
-        let inner = hanging(&[0], 0.02);
-        let outer = hanging(&[0, 1, 1, 2], 0.01);
-        let mut outer_far = outer.clone();
-        outer_far.offsets[2] = [0.0, 0.0, 0.05];
-        let layered = outer_far.over(&[&inner], 0.005, &body_faces);
+        let model = BodyModel::default_body_lod1();
+        let first = model.faces[0];
+        let shares = |f: &[u32; 3]| f.iter().any(|v| first.contains(v));
+        let beside = model.faces.iter().skip(1).position(shares).unwrap() as u32 + 1;
+        let away = model.faces.iter().position(|f| !shares(f)).unwrap() as u32;
+        let inner = hanging(&model, &[0], 0.02);
+        let mut outer = hanging(&model, &[0, beside, beside, away], 0.01);
+        outer.offsets[2] = [0.0, 0.0, 0.05];
+        let layered = outer.over(&[&inner], 0.005, &model).unwrap();
         let z: Vec<f32> = layered.offsets.iter().map(|d| d[2]).collect();
         assert!((z[0] - 0.025).abs() < 1e-7 && (z[1] - 0.025).abs() < 1e-7, "{z:?}");
         assert_eq!(z[2], 0.05);
         assert_eq!(z[3], 0.01);
+    }
+
+    /// Issue 42: a garment made on the default body, worn on the light one, indexed past its
+    /// faces and panicked; it is refused naming both models' sizes, inner or outer.
+    #[test]
+    fn a_garment_of_another_body_is_refused() {
+        let (light, default) = (BodyModel::default_body_lod1(), BodyModel::default_body());
+        let made_on_default = hanging(&default, &[default.faces.len() as u32 - 1], 0.01);
+        let fits = hanging(&light, &[0], 0.01);
+        for e in [
+            made_on_default.over(&[], 0.005, &light).unwrap_err(),
+            fits.over(&[&made_on_default], 0.005, &light).unwrap_err(),
+        ] {
+            let e = e.to_string();
+            let sizes = format!("({} vertices, {} faces)", default.num_vertices(), default.faces.len());
+            assert!(e.starts_with("body: the garment was made on 'test' ") && e.contains(&sizes), "{e}");
+            assert!(e.contains("make it again on this body"), "{e}");
+        }
     }
 }

@@ -14,7 +14,7 @@ use mannequin_mesh::{ClosestPoint, TriMesh, UvLayout};
 use crate::category::Category;
 use crate::error::GarmentError;
 use crate::fit::Fit;
-use crate::garment::{Garment, Recipe};
+use crate::garment::{Garment, Recipe, check_edge_length};
 use crate::region::{Landmarks, covered_region, open_front};
 use crate::sewing::sew_skirt;
 
@@ -40,12 +40,7 @@ pub fn make_garment(
     betas: &[f32],
 ) -> Result<Garment, GarmentError> {
     fit.validate()?;
-    if !(0.003..=0.1).contains(&edge_length) {
-        return Err(GarmentError::invalid(
-            "edge_length",
-            format!("{edge_length} m; expected 0.003 to 0.1 m"),
-        ));
-    }
+    check_edge_length(edge_length)?;
     let shaped = shape_body(model, betas)?;
     let rest: Vec<[f32; 3]> = shaped.vertices.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     let mut body = model.template_mesh();

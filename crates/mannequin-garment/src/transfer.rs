@@ -30,22 +30,8 @@ pub struct Dressed<'a> {
 impl<'a> Dressed<'a> {
     /// `garment` on `model` with shape `betas`; refused when the template hangs on another model.
     pub fn new(garment: &'a Garment, model: &'a BodyModel, betas: &[f32]) -> Result<Self, GarmentError> {
-        let faces = model.template_mesh().faces;
-        let recipe = &garment.recipe;
-        if recipe.body_vertices != model.num_vertices() || recipe.body_faces != faces.len() {
-            return Err(GarmentError::invalid(
-                "body",
-                format!(
-                    "the garment was made on '{}' ({} vertices, {} faces), this body has {} and {}: \
-                     make it again on this body",
-                    recipe.body,
-                    recipe.body_vertices,
-                    recipe.body_faces,
-                    model.num_vertices(),
-                    faces.len()
-                ),
-            ));
-        }
+        garment.check_body(model)?;
+        let faces = model.faces.clone();
         let shaped = shape_body(model, betas)?;
         let mut dressed = Self { garment, model, faces, shaped, betas: betas.to_vec(), weights: Vec::new() };
         let rest = dressed.rest();

@@ -83,7 +83,7 @@ pub fn wear<E: From<GarmentError>>(
     resume: WearProgress,
     on_frame: &mut dyn FnMut(&WearStep) -> Result<(), E>,
 ) -> Result<Vec<WornLayer>, E> {
-    check_progress(&resume, layers, wearer.frames.len())?;
+    resume.check(layers, wearer.frames.len())?;
     let mut worn: Vec<WornLayer> = resume
         .finished
         .into_iter()
@@ -105,39 +105,45 @@ pub fn wear<E: From<GarmentError>>(
     Ok(worn)
 }
 
-/// Refuses progress that is not of these layers on this schedule, naming the field at fault.
-fn check_progress(
-    progress: &WearProgress,
-    layers: &[(&str, &Dressed)],
-    schedule: usize,
-) -> Result<(), GarmentError> {
-    let under_way = usize::from(progress.current.is_some());
-    if progress.finished.len() + under_way > layers.len() {
-        return Err(GarmentError::invalid(
-            "progress.finished",
-            format!(
-                "{} layers finished and {under_way} under way, but {} are worn",
-                progress.finished.len(),
-                layers.len()
-            ),
-        ));
-    }
-    let current = progress.current.iter().map(|c| ("current", &c.frames, 1..schedule));
-    let finished = progress.finished.iter().map(|f| ("finished", f, schedule..schedule + 1));
-    for ((field, frames, expected), (_, dressed)) in finished.chain(current).zip(layers) {
-        let vertices = dressed.garment().vertex_count();
-        if !expected.contains(&frames.len()) || frames.iter().any(|f| f.len() != vertices) {
+impl WearProgress {
+    /// Refuses progress that is not of `layers` on a schedule of `schedule` frames, naming the
+    /// field at fault: too many layers, a layer's frame or vertex count, or a cloth state out of
+    /// its bounds.
+    pub fn check(&self, layers: &[(&str, &Dressed)], schedule: usize) -> Result<(), GarmentError> {
+        let under_way = usize::from(self.current.is_some());
+        if self.finished.len() + under_way > layers.len() {
             return Err(GarmentError::invalid(
-                format!("progress.{field}"),
+                "progress.finished",
                 format!(
-                    "expected {expected:?} frames of {vertices} vertices ({}), found {} frames",
-                    dressed.garment().recipe.category.name(),
-                    frames.len()
+                    "{} layers finished and {under_way} under way, but {} are worn",
+                    self.finished.len(),
+                    layers.len()
                 ),
             ));
         }
+        let current = self.current.iter().map(|c| ("current", &c.frames, 1..schedule));
+        let finished = self.finished.iter().map(|f| ("finished", f, schedule..schedule + 1));
+        for ((field, frames, expected), (_, dressed)) in finished.chain(current).zip(layers) {
+            let vertices = dressed.garment().vertex_count();
+            if !expected.contains(&frames.len()) || frames.iter().any(|f| f.len() != vertices) {
+                return Err(GarmentError::invalid(
+                    format!("progress.{field}"),
+                    format!(
+                        "expected {expected:?} frames of {vertices} vertices ({}), found {} frames",
+                        dressed.garment().recipe.category.name(),
+                        frames.len()
+                    ),
+                ));
+            }
+        }
+        if let (Some(current), Some((_, dressed))) = (&self.current, layers.get(self.finished.len())) {
+            current
+                .state
+                .check(dressed.garment().vertex_count())
+                .map_err(|e| GarmentError::invalid("progress.current", e.to_string()))?;
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// Called after each frame of a layer with its frames so far and the simulator.

@@ -48,7 +48,6 @@ impl Outfit {
 
 /// Makes `outfit` on `model` with shape `betas`, each layer clear of those under it.
 pub fn dress_subject(model: &BodyModel, betas: &[f32], outfit: Outfit) -> Result<Vec<Worn>, DataError> {
-    let body_faces = model.template_mesh().faces;
     let mut worn: Vec<Worn> = Vec::new();
     for &(category, size, piece) in outfit.garments() {
         let fail = |e: mannequin_garment::GarmentError| {
@@ -58,7 +57,7 @@ pub fn dress_subject(model: &BodyModel, betas: &[f32], outfit: Outfit) -> Result
         let made = make_garment(category, fit, EDGE, category.default_material(), model, "default", betas)
             .map_err(fail)?;
         let inner: Vec<&Garment> = worn.iter().map(|w| &w.garment).collect();
-        let garment = made.over(&inner, LAYER_GAP, &body_faces);
+        let garment = made.over(&inner, LAYER_GAP, model).map_err(fail)?;
         worn.push(Worn { name: category.name(), piece, garment });
     }
     Ok(worn)

@@ -126,9 +126,9 @@ pub fn run(args: Args) -> Result<()> {
         .enumerate()
         .map(|(i, (name, g))| {
             let inner: Vec<&Garment> = loaded[..i].iter().map(|(_, g)| g).collect();
-            (name.clone(), g.over(&inner, LAYER_GAP, &body_faces))
+            Ok((name.clone(), g.over(&inner, LAYER_GAP, &model).with_context(|| name.clone())?))
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let worn: Vec<Worn> = templates
         .iter()
         .enumerate()
@@ -408,6 +408,7 @@ pub(crate) fn load_or_make(
             );
         }
         let garment = read_garment(path)?;
+        garment.check_body(model).with_context(|| path.display().to_string())?;
         let name = path.file_stem().map_or_else(|| "garment".into(), |s| s.to_string_lossy().into_owned());
         return Ok((name, garment));
     };
