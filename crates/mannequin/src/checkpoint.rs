@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use mannequin_cloth::ClothState;
+use anyhow::{Context, Result, anyhow, bail};
+use mannequin_cloth::{ClothState, check_positions};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::points;
 use serde::Serialize;
@@ -53,9 +53,11 @@ pub fn frames_array(frames: &[Vec<[f32; 3]>], vertices: usize) -> NpyArray {
     NpyArray::f32(vec![frames.len(), vertices, 3], flat)
 }
 
-/// The [frames, vertices, 3] array under `key`, checked against `vertices`.
+/// The [frames, vertices, 3] array under `key`, checked against `vertices` and
+/// [`mannequin_cloth::MAX_COORDINATE`].
 pub fn read_frames(npz: &Npz, key: &str, vertices: usize) -> Result<Vec<Vec<[f32; 3]>>> {
     let values = read_points(npz, key, &[None, Some(vertices), Some(3)])?;
+    check_positions(key, &values).map_err(|e| anyhow!("{}: {e}", npz.path.display()))?;
     Ok(values.chunks_exact(vertices.max(1)).map(<[_]>::to_vec).collect())
 }
 
@@ -73,8 +75,11 @@ pub fn add_state(w: &mut NpzWriter, state: &ClothState) {
     }
 }
 
-/// The state [`add_state`] stored, checked against `vertices`.
+/// The state [`add_state`] stored, checked against `vertices` and the physical bounds
+/// ([`ClothState::check`]).
 pub fn read_state(npz: &Npz, vertices: usize) -> Result<ClothState> {
     let read = |key: &str| read_points(npz, key, &[Some(vertices), Some(3)]);
-    Ok(ClothState { positions: read("positions")?, velocities: read("velocities")? })
+    let state = ClothState { positions: read("positions")?, velocities: read("velocities")? };
+    state.check(vertices).map_err(|e| anyhow!("{}: {e}", npz.path.display()))?;
+    Ok(state)
 }

@@ -24,6 +24,8 @@ use crate::checkpoint::{
 };
 use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
+use crate::sim_limits::{MAX_SUBSTEPS, check_kept_positions, parse_settle};
+use crate::staging::Staging;
 
 #[derive(Subcommand)]
 pub enum ClothCommand {
@@ -47,11 +49,16 @@ pub struct SimulateArgs {
     clip: Clip,
     #[arg(long, default_value = "cotton", value_parser = clap::builder::PossibleValuesParser::new(MATERIAL_NAMES))]
     material: String,
-    /// Simulation substeps per output frame (one constraint iteration each).
-    #[arg(long, default_value_t = 20)]
+    /// Simulation substeps per output frame (one constraint iteration each), at most 100.
+    #[arg(
+        long,
+        default_value_t = 20,
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(u32).range(1..=MAX_SUBSTEPS as i64)
+    )]
     substeps: u32,
-    /// Seconds before the motion: half at rest, half blending into its first frame.
-    #[arg(long, default_value_t = 1.0)]
+    /// Seconds before the motion: half at rest, half blending into its first frame (at most 10).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = parse_settle)]
     settle: f32,
     /// Cloth–cloth contacts (vertex–triangle, Eq. 3.22). Experimental: cloth piling onto itself
     /// still tangles in places and they cost about 4× the time, so they are off unless asked
@@ -98,6 +105,9 @@ fn read_pins(path: &Path, vertices: usize) -> Result<Pins> {
             );
         }
     }
+    if let Some(v) = pins.attached.iter().find(|v| pins.fixed.contains(v)) {
+        bail!("{}: attached: vertex {v} is also fixed; expected each vertex in one list", path.display());
+    }
     Ok(pins)
 }
 
@@ -128,6 +138,15 @@ struct FrameMetrics {
     simulation_ms: f64,
 }
 
+impl FrameMetrics {
+    /// Whether these are motion frame `frame`'s, every measure finite and non-negative.
+    fn is_frame(&self, frame: usize) -> bool {
+        let measures = [self.max_edge_strain, self.mean_edge_strain].map(f64::from);
+        self.frame == frame
+            && measures.into_iter().chain([self.simulation_ms]).all(|x| x.is_finite() && x >= 0.0)
+    }
+}
+
 /// Where a run stands: the next schedule frame to reach, and what it has recorded.
 struct Progress {
     next: usize,
@@ -146,17 +165,47 @@ fn write_checkpoint(path: &Path, run: &ClothRun, state: &ClothState, progress: &
     Ok(())
 }
 
-/// The checkpoint's progress and state, if it is one of `run`; an error naming the settings that
-/// differ if it is another run's.
-fn read_checkpoint(path: &Path, run: &ClothRun, vertices: usize) -> Result<(Progress, ClothState)> {
+/// The checkpoint's progress and state, if it is one of `run` on `schedule`; an error naming
+/// the settings that differ if it is another run's, or the field that is not what this run
+/// would have saved.
+fn read_checkpoint(
+    path: &Path,
+    run: &ClothRun,
+    vertices: usize,
+    schedule: &Settling,
+) -> Result<(Progress, ClothState)> {
     let npz = Npz::read(path)?;
     check_run(&npz, path, run)?;
-    let next = npz.require("next")?.to_i64().and_then(|n| n.first().copied()).unwrap_or(-1);
-    let next = usize::try_from(next).map_err(|_| npz.field_error("next", "a frame number"))?;
+    let last = schedule.len() - 1;
+    let raw = npz.require("next")?.to_i64().filter(|n| n.len() == 1).map(|n| n[0]);
+    let Some(next) = raw.and_then(|n| usize::try_from(n).ok()).filter(|n| (1..=last).contains(n)) else {
+        bail!(
+            "{}: next: {}; expected one frame number from 1 to {last} (the run's {} frames, settling included)",
+            path.display(),
+            raw.map_or("not one whole number".into(), |n| n.to_string()),
+            schedule.len()
+        );
+    };
     let state = read_state(&npz, vertices)?;
     let frames = read_frames(&npz, "frames", vertices)?;
-    let metrics = serde_json::from_str(npz.text("metrics")?)
+    let recorded = next.saturating_sub(schedule.settle);
+    if frames.len() != recorded {
+        bail!(
+            "{}: frames: {} frames; expected {recorded}, the motion frames before frame {next} of the run",
+            path.display(),
+            frames.len()
+        );
+    }
+    let metrics: Vec<FrameMetrics> = serde_json::from_str(npz.text("metrics")?)
         .with_context(|| format!("{}: metrics: expected the per-frame metrics as JSON", path.display()))?;
+    let wrong = |i: usize| i >= recorded || metrics.get(i).is_none_or(|m| !m.is_frame(i));
+    if let Some(i) = (0..metrics.len().max(recorded)).find(|&i| wrong(i)) {
+        bail!(
+            "{}: metrics: entry {i} is not motion frame {i}'s; expected {recorded} entries of finite, \
+             non-negative measures",
+            path.display()
+        );
+    }
     Ok((Progress { next, frames, metrics }, state))
 }
 
@@ -200,6 +249,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         Cloth::new(&garment, &material, &pins.fixed).with_context(|| garment_path.display().to_string())?;
     let model = load_body(&args.body.body)?;
     let motion = args.clip.load()?;
+    check_kept_positions(&args.clip.motion, motion.num_frames(), garment.vertex_count())?;
     let schedule = Settling::new(&model, &motion, args.settle)?;
     let shaped = shape_body(&model, &args.body.betas)?;
     let faces = model.template_mesh().faces;
@@ -234,14 +284,13 @@ fn simulate(args: SimulateArgs) -> Result<()> {
     let settings =
         Settings { substeps: args.substeps, self_collision: run.self_collision, ..Settings::default() };
     let mut sim = Simulator::new(cloth, Some(Body::new(faces.clone())), attachments, settings)?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let checkpoint = args.out.join(CHECKPOINT);
     if args.restart {
         std::fs::remove_file(&checkpoint).ok();
     }
     let mut progress = Progress { next: 1, frames: Vec::new(), metrics: Vec::new() };
     if checkpoint.exists() {
-        let (resumed, state) = read_checkpoint(&checkpoint, &run, garment.vertex_count())?;
+        let (resumed, state) = read_checkpoint(&checkpoint, &run, garment.vertex_count(), &schedule)?;
         sim.restore(state)?;
         tracing::info!("resuming {} at frame {} of {}", checkpoint.display(), resumed.next, schedule.len());
         progress = resumed;
@@ -318,7 +367,8 @@ fn record(
     progress.frames.push(positions);
 }
 
-/// garment.pc2, garment.npz, scene.glb and metrics.json for the frames recorded so far.
+/// garment.pc2, garment.npz, scene.glb and metrics.json for the frames recorded so far, put in
+/// place together once all are written.
 fn write_outputs(
     dir: &Path,
     garment: &TriMesh,
@@ -330,14 +380,16 @@ fn write_outputs(
 ) -> Result<()> {
     let frames = &progress.frames;
     let (f, v) = (frames.len(), garment.vertex_count());
-    PointCache { start: 0.0, sampling: 1.0, frames: frames.clone() }.write(&dir.join("garment.pc2"))?;
+    let staging = Staging::new(dir)?;
+    PointCache { start: 0.0, sampling: 1.0, frames: frames.clone() }
+        .write(&staging.dir().join("garment.pc2"))?;
 
     let mut npz = NpzWriter::new();
     npz.add("positions", NpyArray::f32(vec![f, v, 3], frames.iter().flatten().flatten().copied().collect()));
     let faces: Vec<i64> = garment.faces.iter().flatten().map(|&i| i as i64).collect();
     npz.add("faces", NpyArray::i64(vec![garment.face_count(), 3], faces));
     npz.add("fps", NpyArray::f64(vec![1], vec![motion.fps as f64]));
-    npz.write(dir.join("garment.npz"))?;
+    npz.write(staging.dir().join("garment.npz"))?;
 
     let skinned = skinned_body(model, betas)?;
     let poses = motion.poses_for(model)?;
@@ -347,7 +399,7 @@ fn write_outputs(
     let mut mesh = garment.clone();
     mesh.positions = frames[0].clone();
     let cache = MorphSequence { name: "garment".into(), mesh, frames: frames.clone(), fps: motion.fps };
-    write_scene_glb(dir.join("scene.glb"), &skinned, Some(&animation), &[cache])?;
+    write_scene_glb(staging.dir().join("scene.glb"), &skinned, Some(&animation), &[cache])?;
 
     let m = &progress.metrics;
     let phases: serde_json::Map<String, serde_json::Value> = sim
@@ -370,8 +422,10 @@ fn write_outputs(
         "per_frame": m,
     });
     let text = serde_json::to_string_pretty(&summary)?;
-    mannequin_io::write_atomic(&dir.join("metrics.json"), text.as_bytes())
-        .with_context(|| format!("writing {}", dir.join("metrics.json").display()))?;
+    let metrics = staging.dir().join("metrics.json");
+    mannequin_io::write_atomic(&metrics, text.as_bytes())
+        .with_context(|| format!("writing {}", metrics.display()))?;
+    staging.commit()?;
     tracing::info!(
         "wrote {}: {f} frames of {v} vertices; {:.1} ms per frame; at most {} vertices inside the body, {} self-intersecting pairs",
         dir.display(),

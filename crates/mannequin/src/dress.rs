@@ -26,6 +26,9 @@ use crate::checkpoint::{
 };
 use crate::motion::Clip;
 use crate::progress::{JobTimer, bar};
+use crate::sim_limits::{MAX_SUBSTEPS, check_kept_positions, parse_settle};
+use crate::splat::read_camera;
+use crate::staging::Staging;
 
 mod fit_report;
 mod frames;
@@ -48,11 +51,16 @@ pub struct Args {
     /// Camera JSON (K, extrinsic, width, height) for the frames; default: a front view framing the clip.
     #[arg(long)]
     camera: Option<PathBuf>,
-    /// Simulation substeps per frame.
-    #[arg(long, default_value_t = 20)]
+    /// Simulation substeps per frame, at most 100.
+    #[arg(
+        long,
+        default_value_t = 20,
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(u32).range(1..=MAX_SUBSTEPS as i64)
+    )]
     substeps: u32,
-    /// Seconds before the motion: half at rest, half blending into its first frame.
-    #[arg(long, default_value_t = 1.0)]
+    /// Seconds before the motion: half at rest, half blending into its first frame (at most 10).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = parse_settle)]
     settle: f32,
     /// Skin the garments only (Eqs. 3.2–3.3), without the cloth simulator.
     #[arg(long)]
@@ -113,12 +121,16 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let model = load_body(&args.body.body)?;
     let motion = args.clip.load()?;
+    let camera = args.camera.as_deref().map(read_camera).transpose()?.map(|(camera, _)| camera);
     let betas = &args.body.betas;
     let loaded: Vec<(String, Garment)> = args
         .garments
         .iter()
         .map(|g| load_or_make(g, &model, &args.body.body, &args.size))
         .collect::<Result<_>>()?;
+    let settle = Settling::settle_frames(args.settle, motion.fps)?;
+    let vertices = model.num_vertices() + loaded.iter().map(|(_, g)| g.vertex_count()).sum::<usize>();
+    check_kept_positions(&args.clip.motion, settle + motion.num_frames(), vertices)?;
     // Each layer stands clear of those under it (in rest space, so on every body shape).
     let body_faces = model.template_mesh().faces;
     let templates: Vec<(String, Garment)> = loaded
@@ -150,7 +162,6 @@ pub fn run(args: Args) -> Result<()> {
     let body_frames = schedule.body_frames(&model, &shaped)?;
     stage("body", start);
 
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let checkpoint = args.out.join(CHECKPOINT);
     if args.restart {
         std::fs::remove_file(&checkpoint).ok();
@@ -185,7 +196,7 @@ pub fn run(args: Args) -> Result<()> {
             self_collision: args.self_collision,
         };
         let resume = if checkpoint.exists() {
-            let resume = read_checkpoint(&checkpoint, &run, &worn)?;
+            let resume = read_checkpoint(&checkpoint, &run, &named, schedule.len())?;
             tracing::info!("resuming {}", checkpoint.display());
             resume
         } else {
@@ -303,6 +314,7 @@ pub fn run(args: Args) -> Result<()> {
     stage("metrics", start);
 
     let start = Instant::now();
+    let staging = Staging::new(&args.out)?;
     if !args.no_frames {
         let meshes: Vec<(&[[u32; 3]], [f32; 3])> = worn
             .iter()
@@ -313,16 +325,17 @@ pub fn run(args: Args) -> Result<()> {
             motion_frames.clone().map(|k| layers.iter().map(|l| l[k].as_slice()).collect()).collect();
         let body_motion: Vec<&[[f32; 3]]> =
             motion_frames.clone().map(|k| body_frames[k].as_slice()).collect();
-        frames::render(&scene, &body_motion, &garment_frames, args.camera.as_deref(), &args.out, motion.fps)?;
+        frames::render(&scene, &body_motion, &garment_frames, camera.as_ref(), staging.dir(), motion.fps)?;
     }
     stage("render", start);
 
     let start = Instant::now();
     let motion_layers: Vec<Vec<Vec<[f32; 3]>>> =
         layers.iter().map(|l| l[motion_frames.clone()].to_vec()).collect();
-    write_scene(&args.out, &model, betas, &motion, &worn, &motion_layers)?;
+    write_scene(staging.dir(), &model, betas, &motion, &worn, &motion_layers)?;
     stage("write", start);
-    write_metrics(&args.out, &worn, &metrics, motion.fps, stage_s)?;
+    write_metrics(staging.dir(), &worn, &metrics, motion.fps, stage_s)?;
+    staging.commit()?;
     if !args.no_simulation {
         std::fs::remove_file(&checkpoint).ok();
     }
@@ -370,13 +383,19 @@ fn write_checkpoint(path: &Path, run: &DressRun, progress: &WearProgress, worn: 
     Ok(())
 }
 
-/// The progress a checkpoint of `run` holds; an error naming what differs for another run's.
-fn read_checkpoint(path: &Path, run: &DressRun, worn: &[Worn]) -> Result<WearProgress> {
+/// The progress a checkpoint of `run` holds for `layers` on a schedule of `schedule` frames; an
+/// error naming what differs for another run's, or the field that is not what this run saves.
+fn read_checkpoint(
+    path: &Path,
+    run: &DressRun,
+    layers: &[(&str, &Dressed)],
+    schedule: usize,
+) -> Result<WearProgress> {
     let npz = Npz::read(path)?;
     check_run(&npz, path, run)?;
     let mut progress = WearProgress::default();
-    for (i, layer) in worn.iter().enumerate() {
-        let vertices = layer.garment.vertex_count();
+    for (i, (_, layer)) in layers.iter().enumerate() {
+        let vertices = layer.garment().vertex_count();
         let key = format!("finished_{i}");
         if npz.contains(&key) {
             progress.finished.push(read_frames(&npz, &key, vertices)?);
@@ -388,6 +407,7 @@ fn read_checkpoint(path: &Path, run: &DressRun, worn: &[Worn]) -> Result<WearPro
             break;
         }
     }
+    progress.check(layers, schedule).with_context(|| path.display().to_string())?;
     Ok(progress)
 }
 

@@ -9,6 +9,7 @@ use std::process::{Command, Stdio};
 mod common;
 use common::{mannequin, ok, one_line_error, s, scratch};
 use mannequin_body::BodyModel;
+use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::ring_tube::RingLayout;
 use mannequin_mesh::{PointCache, TriMesh, write_obj};
 
@@ -198,6 +199,81 @@ fn bad_garments_are_one_line_errors() {
     one_line_error(&simulate(&square, Some(&pins)), &["pins.json", "fixed", "vertex 7", "3 vertices"]);
     let nan = write("nan.obj", "v 0 0 0.2\nv nan 0 0.2\nv 0 0.1 0.2\nf 1 2 3\n");
     one_line_error(&simulate(&nan, None), &["nan.obj"]);
+    // Issue 42: each of these was simulated.
+    let corners = "v 0 0 0.2\nv 0.1 0 0.2\nv 0.1 0.1 0.2\nv 0 0.1 0.2\n";
+    let bowtie = write("bowtie.obj", &format!("{corners}v -0.1 0 0.2\nv -0.1 -0.1 0.2\nf 1 2 3\nf 1 5 6\n"));
+    one_line_error(&simulate(&bowtie, None), &["bowtie.obj", "faces", "vertex 0", "more than one fan"]);
+    let flipped = write("flipped.obj", &format!("{corners}f 1 2 3\nf 1 4 3\n"));
+    one_line_error(&simulate(&flipped, None), &["flipped.obj", "faces 0 and 1", "the same way"]);
+    let loose = write("loose.obj", &format!("{corners}f 1 2 3\n"));
+    one_line_error(&simulate(&loose, None), &["loose.obj", "vertex 3 is in no triangle"]);
+    let both = write("both.json", r#"{"fixed": [1, 2], "attached": [0, 2]}"#);
+    one_line_error(&simulate(&square, Some(&both)), &["both.json", "attached", "vertex 2 is also fixed"]);
+    assert!(!dir.join("out").exists(), "a refused run writes nothing");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Issue 42: a run whose outputs cannot all be written leaves none of them and keeps its last
+/// checkpoint; a checkpoint that is not what this run saves (a frame counter past the motion,
+/// frames cut short or outnumbering it, velocities of 1e30) is refused naming the field, and the
+/// good one resumes to every frame of the motion.
+#[test]
+fn a_failed_run_leaves_no_outputs_and_a_bad_checkpoint_is_refused() {
+    let dir = scratch("cloth-checkpoint");
+    let SkirtOnAWalk { garment, pins, walk, .. } = skirt_on_a_walk(&dir, "0.5");
+    let out = dir.join("sim");
+    let run = || {
+        let a = ["cloth", "simulate", "--garment", s(&garment), "--pin", s(&pins), "--motion", s(&walk)];
+        let b = ["--settle", "0.1", "--checkpoint-every", "5", "--substeps", "5", "--out", s(&out)];
+        mannequin(&a.iter().chain(&b).copied().collect::<Vec<_>>())
+    };
+    std::fs::create_dir_all(out.join("metrics.json")).unwrap();
+    one_line_error(&run(), &["metrics.json", "a folder is in the way"]);
+    let mut left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["checkpoint.npz", "metrics.json"], "only the checkpoint is new");
+    std::fs::remove_dir(out.join("metrics.json")).unwrap();
+
+    // Settling takes 3 frames before the motion's; the last checkpoint is at a multiple of 5.
+    let motion_frames = mannequin_body::Motion::read(&walk).unwrap().num_frames();
+    let last = 3 + motion_frames - 1;
+    let recorded = last / 5 * 5 - 3;
+    let checkpoint = out.join("checkpoint.npz");
+    let good = dir.join("good.npz");
+    std::fs::copy(&checkpoint, &good).unwrap();
+    let npz = Npz::read(&good).unwrap();
+    let (_, frames) = npz.f64_with_shape("frames", &[Some(recorded), None, Some(3)]).unwrap();
+    let per_frame = frames.len() / recorded;
+    let frames_of = |n: usize| {
+        let values = (0..n * per_frame).map(|i| frames[i % frames.len()] as f32).collect();
+        NpyArray::f32(vec![n, per_frame / 3, 3], values)
+    };
+    let (_, v) = npz.f64_with_shape("velocities", &[None, Some(3)]).unwrap();
+    let fast = NpyArray::f32(vec![v.len() / 3, 3], vec![1e30; v.len()]);
+    let expected = |n: usize| format!("frames: {n} frames; expected {recorded}");
+    for (key, array, needle) in [
+        ("next", NpyArray::i64(vec![1], vec![last as i64 + 20]), format!("next: {}", last + 20)),
+        ("frames", frames_of(recorded - 2), expected(recorded - 2)),
+        ("frames", frames_of(motion_frames + 5), expected(motion_frames + 5)),
+        ("velocities", fast, "state.velocities: entry 0".into()),
+    ] {
+        let mut w = NpzWriter::new();
+        for k in npz.keys().filter(|&k| k != key) {
+            w.add(k, npz.get(k).unwrap().clone());
+        }
+        w.add(key, array);
+        w.write(&checkpoint).unwrap();
+        let o = run();
+        one_line_error(&o, &["checkpoint.npz", &needle]);
+        assert!(!out.join("garment.pc2").exists(), "a refused resume writes nothing");
+    }
+    std::fs::copy(&good, &checkpoint).unwrap();
+    ok(run());
+    assert_eq!(PointCache::read(&out.join("garment.pc2")).unwrap().frames.len(), motion_frames);
+    assert!(!checkpoint.exists(), "a finished run leaves no checkpoint");
     std::fs::remove_dir_all(dir).ok();
 }
 

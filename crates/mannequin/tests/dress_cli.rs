@@ -9,7 +9,7 @@
 use std::path::Path;
 
 mod common;
-use common::{mannequin, ok, one_line_error, read_json, s, scratch};
+use common::{mannequin, ok, one_line_error, read_json, s, scratch, usage_error};
 use mannequin_mesh::PointCache;
 
 #[path = "../../../tools/node_checks.rs"]
@@ -49,7 +49,16 @@ fn a_made_template_reads_back() {
     let lod1 = dir.join("lod1.garment");
     ok(mannequin(&["garment", "make", "--category", "pants", "--body", "default-lod1", "--out", s(&lod1)]));
     let o = mannequin(&["dress", "--garments", s(&lod1), "--motion", s(&walk), "--out", s(&dir.join("x"))]);
-    one_line_error(&o, &["lod1", "make it again on this body"]);
+    one_line_error(&o, &["lod1.garment", "make it again on this body"]);
+    // And the reverse (issue 42: it panicked, layering the template on faces the body lacks).
+    let args = ["dress", "--body", "default-lod1", "--garments", s(&file), "--motion", s(&walk)];
+    let o = mannequin(&[&args[..], &["--out", s(&dir.join("x"))]].concat());
+    one_line_error(&o, &["tshirt.garment", "body: the garment was made on 'default' (", "make it again"]);
+    // Issue 42: `--settle inf` grew to 24 GB.
+    let o =
+        mannequin(&["dress", "--garments", s(&file), "--motion", s(&walk), "--settle", "inf", "--out", "x"]);
+    usage_error(&o, &["--settle", "expected 0 to 10 seconds"]);
+    assert!(!dir.join("x").exists(), "a refused dress writes nothing");
     let o = mannequin(&["dress", "--garments", "tunic", "--motion", s(&walk), "--out", s(&dir.join("x"))]);
     one_line_error(&o, &["tunic", "pants, short-pants, shirt, tshirt, long-coat, skirt, dress"]);
 }

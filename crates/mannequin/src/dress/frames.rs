@@ -13,7 +13,6 @@ use rayon::prelude::*;
 
 use crate::animate::{clip_camera, write_video};
 use crate::progress::bar;
-use crate::splat::read_camera;
 
 /// Skin's colour, linear RGB.
 const SKIN: [f32; 3] = [0.8, 0.6, 0.5];
@@ -55,17 +54,17 @@ pub fn render_frame(scene: &Scene, body: &[[f32; 3]], garments: &[&[[f32; 3]]], 
 }
 
 /// Renders every frame to `dir/frames/frame_%04d.png` (and `dir/frames.mp4` with ffmpeg), through
-/// `camera_path` or a front view that frames the whole clip.
+/// `camera` or a front view that frames the whole clip.
 pub fn render(
     scene: &Scene,
     body: &[&[[f32; 3]]],
     garments: &[Vec<&[[f32; 3]]>],
-    camera_path: Option<&Path>,
+    camera: Option<&Camera>,
     dir: &Path,
     fps: f32,
 ) -> Result<()> {
-    let camera = match camera_path {
-        Some(path) => read_camera(path)?.0,
+    let camera = match camera {
+        Some(camera) => camera.clone(),
         None => {
             let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
             for p in
