@@ -150,8 +150,7 @@ pub fn reconstruct(
     if train.frames.is_empty() {
         bail!("{}: the train split has no frames", data.display());
     }
-    let (_, garment) = load_or_make(category, &model, body, &ngd.size)?;
-    let dressed = Dressed::new(&garment, &model, &train.poses.betas)?;
+    // The targets first: a broken label map is refused before the template is made (seconds).
     let frames = train
         .frames
         .iter()
@@ -162,6 +161,8 @@ pub fn reconstruct(
             Ok(TrainingFrame { target, camera, pose: frame_pose(&train, k) })
         })
         .collect::<Result<Vec<_>>>()?;
+    let (_, garment) = load_or_make(category, &model, body, &ngd.size)?;
+    let dressed = Dressed::new(&garment, &model, &train.poses.betas)?;
     let has_normals = frames.iter().all(|f| f.target.normals.is_some());
     let normal_weight = match ngd.normal_weight {
         Some(w) if w > 0.0 && !has_normals => bail!(
