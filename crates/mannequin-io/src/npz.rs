@@ -23,13 +23,23 @@ pub struct Npz {
 impl Npz {
     /// Reads and decodes every array in the archive.
     pub fn read(path: impl AsRef<Path>) -> Result<Self, IoError> {
+        Self::read_within(path, MAX_ARCHIVE_ELEMENTS)
+    }
+
+    /// [`Npz::read`] for a reader that knows how large its file can be: an archive whose arrays
+    /// declare more than `max_elements` in all is refused by their headers, before inflating.
+    pub fn read_within(path: impl AsRef<Path>, max_elements: usize) -> Result<Self, IoError> {
         let path = path.as_ref().to_path_buf();
         let bytes = std::fs::read(&path).map_err(|source| IoError::Io { path: path.clone(), source })?;
-        Self::from_bytes(path, &bytes)
+        Self::decode(path, &bytes, max_elements.min(MAX_ARCHIVE_ELEMENTS))
     }
 
     /// Decodes an archive held in memory; `path` is used only in error messages.
     pub fn from_bytes(path: PathBuf, bytes: &[u8]) -> Result<Self, IoError> {
+        Self::decode(path, bytes, MAX_ARCHIVE_ELEMENTS)
+    }
+
+    fn decode(path: PathBuf, bytes: &[u8], max_elements: usize) -> Result<Self, IoError> {
         let archive_err = |reason: String| IoError::Archive { path: path.clone(), reason };
         let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| archive_err(e.to_string()))?;
         let mut arrays = BTreeMap::new();
@@ -38,7 +48,7 @@ impl Npz {
             let entry = zip.by_index(i).map_err(|e| archive_err(e.to_string()))?;
             let name = entry.name().to_string();
             let key = name.strip_suffix(".npy").unwrap_or(&name).to_string();
-            let array = read_member(entry, bytes.len(), &mut elements)
+            let array = read_member(entry, bytes.len(), &mut elements, max_elements)
                 .and_then(|member| Ok(parse_npy(&member)?))
                 .map_err(|e| match e {
                     MemberError::Inflate(e) => archive_err(format!("member '{name}': {e}")),
@@ -172,14 +182,15 @@ impl From<NpyError> for MemberError {
 /// Inflates one member no further than its `.npy` header declares (header plus shape × dtype
 /// bytes), so a zip bomb costs only what its header admits to: the header is read first, then
 /// at most the declared length and one byte more, which is refused. The header's shape is held
-/// to [`MAX_ARRAY_ELEMENTS`], and `elements` (the archive's running total) to
-/// [`MAX_ARCHIVE_ELEMENTS`], before anything is inflated: a few kilobytes of deflated zeros may
+/// to [`MAX_ARRAY_ELEMENTS`], and `elements` (the archive's running total) to `max_elements`,
+/// before anything is inflated: a few kilobytes of deflated zeros may
 /// honestly hold gigabytes. Nothing is reserved by the archive's own size fields, and never more
 /// than the archive's length (all a stored member needs).
 fn read_member(
     mut entry: impl Read,
     archive_len: usize,
     elements: &mut usize,
+    max_elements: usize,
 ) -> Result<Vec<u8>, MemberError> {
     let mut buf = Vec::new();
     (&mut entry).take(npy::PREFIX_LEN as u64).read_to_end(&mut buf)?;
@@ -193,9 +204,9 @@ fn read_member(
         ))));
     }
     *elements += count;
-    if *elements > MAX_ARCHIVE_ELEMENTS {
+    if *elements > max_elements {
         return Err(MemberError::Npy(NpyError::Format(format!(
-            "shape {shape:?} brings the archive to {} elements, expected at most {MAX_ARCHIVE_ELEMENTS} in all",
+            "shape {shape:?} brings the archive to {} elements, expected at most {max_elements} in all",
             *elements
         ))));
     }
@@ -405,6 +416,25 @@ mod tests {
         assert!(err.contains("'c'") && err.contains("in all"), "{err}");
         let ok = zipped(&[("a.npy", write_npy(&NpyArray::f32(vec![2], vec![1.0, 2.0])))]);
         assert!(Npz::from_bytes("m.npz".into(), &ok).is_ok());
+    }
+
+    /// A reader's own bound refuses a header within the global limits but past what its file can
+    /// hold, before inflating; an archive within it reads.
+    #[test]
+    fn a_readers_bound_is_held_before_inflating() {
+        let path = std::env::temp_dir().join(format!("mq-npz-within-{}.npz", std::process::id()));
+        std::fs::write(
+            &path,
+            zipped(&[("a.npy", write_npy(&NpyArray::f32(vec![4], vec![0.0; 4]))), ("b.npy", u8_header(100))]),
+        )
+        .unwrap();
+        let err = Npz::read_within(&path, 50).unwrap_err().to_string();
+        assert!(err.contains("'b'") && err.contains("104 elements, expected at most 50 in all"), "{err}");
+        assert!(Npz::read_within(&path, 4).unwrap_err().to_string().contains("'b'"));
+        std::fs::write(&path, zipped(&[("a.npy", write_npy(&NpyArray::f32(vec![4], vec![0.0; 4])))]))
+            .unwrap();
+        assert!(Npz::read_within(&path, 4).is_ok());
+        std::fs::remove_file(path).unwrap();
     }
 
     #[test]
