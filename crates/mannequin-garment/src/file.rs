@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mannequin_cloth::{MAX_GARMENT_VERTICES, check_garment, check_positions};
+use mannequin_cloth::{MAX_GARMENT_FACES, MAX_GARMENT_VERTICES, check_garment, check_positions};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::{SurfacePoint, TriMesh, UvLayout, points};
 
@@ -39,6 +39,12 @@ pub fn write_garment(path: &Path, g: &Garment) -> Result<(), GarmentError> {
     Ok(())
 }
 
+/// Most array elements a `.garment` holds, checked from its arrays' headers before any is
+/// inflated: a template at the simulator's limits has 10 per vertex (position, binding face and
+/// weights, offset) and 12 per triangle (corners, UV corners, and at most 3 UVs of 2), and two
+/// texts.
+const MAX_ELEMENTS: usize = 10 * MAX_GARMENT_VERTICES + 12 * MAX_GARMENT_FACES + 2;
+
 /// Farthest a garment vertex may hang off the body point it is bound to (m): a flared hem
 /// stands some 30 cm off the legs; a metre off is no garment worn on this body.
 pub const MAX_OFFSET: f32 = 1.0;
@@ -50,7 +56,7 @@ const BARY_TOLERANCE: f32 = 1e-3;
 /// Reads a `.garment` file, refusing one that `write_garment` would not have written from a
 /// template that can be simulated: every refusal names the file and the field.
 pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
-    let npz = Npz::read(path)?;
+    let npz = Npz::read_within(path, MAX_ELEMENTS)?;
     let file_error = |reason: String| GarmentError::File { path: path.display().to_string(), reason };
     let format = npz.text("format")?;
     if format != FORMAT {
@@ -68,11 +74,6 @@ pub fn read_garment(path: &Path) -> Result<Garment, GarmentError> {
     };
     let (shape, positions) = floats("positions", &[None, Some(3)])?;
     let n = shape[0];
-    if n > MAX_GARMENT_VERTICES {
-        return Err(npz
-            .field_error("positions", format!("{n} rows; expected at most {MAX_GARMENT_VERTICES}"))
-            .into());
-    }
     let triples = |key: &str, count: usize| -> Result<Vec<[u32; 3]>, GarmentError> {
         let (_, v) = npz.f64_with_shape(key, &[None, Some(3)])?;
         if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i >= count as f64 || i.fract() != 0.0) {

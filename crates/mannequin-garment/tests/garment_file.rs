@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use mannequin_body::{BodyModel, shape_body};
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{Category, Fit, Garment, Recipe};
-use mannequin_io::{NpyArray, Npz, NpzWriter};
+use mannequin_io::{NpyArray, NpyData, Npz, NpzWriter};
 use mannequin_mesh::{ClosestPoint, TriMesh};
 
 /// A 2 cm square of two triangles, 2 cm in front of the light body's first vertex, bound to it.
@@ -110,6 +110,13 @@ fn a_garment_that_cannot_be_worn_is_refused_naming_file_and_field() {
             "body_bary",
             points(&[[2.0, -1.0, 0.0]; 4]),
             "field 'body_bary': row 0 is [2.0, -1.0, 0.0]",
+        ),
+        // A header alone claiming 3 million vertices: refused before anything is inflated.
+        (
+            "huge_header",
+            "positions",
+            NpyArray { shape: vec![3_000_000, 3], data: NpyData::F32(vec![]) },
+            "field 'positions': shape [3000000, 3] brings the archive to",
         ),
     ];
     for (name, key, array, message) in cases {
