@@ -276,6 +276,26 @@ fn flag_cases(fx: &Fixtures, dir: &Path, base: &Base, cases: &mut Vec<Case>) {
     let args = simulate(fx, &case, &base.band, None, &["--material", "vibranium"]);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     cases.push(Case::usage("cloth/flags/cloth_material", &case, &args, &["--material", "vibranium"]));
+    // The clip's flags, as these verbs take them.
+    let clip: [(&str, &str, &str); 5] = [
+        ("--fps", "0", "frame rate"),
+        ("--fps", "inf", "frame rate"),
+        ("--fps", "NaN", "frame rate"),
+        ("--fps", "1e9", "expected at most 1000 times"),
+        ("--max-frames", "0", "--max-frames"),
+    ];
+    for verb in ["cloth", "dress"] {
+        for (flag, value, needle) in clip {
+            let name = format!("flags/{verb}_{}_{value}", &flag[2..]);
+            let case = folder(dir, &name);
+            let extra = ["--body", "default-lod1", flag, value];
+            let args = match verb {
+                "cloth" => simulate(fx, &case, &base.band, None, &extra),
+                _ => dress(fx, &case, &base.tshirt, &extra),
+            };
+            cases.push(refused(&name, &case, &args, &[needle]));
+        }
+    }
     // A settling period within the flag's limit is refused by the frames it makes at a rate no
     // motion has (here 1000 fps, resampled from the walk's 30).
     for verb in ["cloth", "dress"] {
