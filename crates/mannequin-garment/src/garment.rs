@@ -31,9 +31,9 @@ pub struct Recipe {
     pub body_faces: usize,
 }
 
-/// Target edge lengths a template is made at (m): under 3 mm the remesher makes millions of
-/// triangles of a coat; over 10 cm a sleeve is a few triangles round.
-pub const EDGE_LENGTH_RANGE: std::ops::RangeInclusive<f32> = 0.003..=0.1;
+/// Target edge lengths a template is made at (m): under 5 mm a long coat passes the simulator's
+/// [`mannequin_cloth::MAX_GARMENT_FACES`]; over 10 cm a sleeve is a few triangles round.
+pub const EDGE_LENGTH_RANGE: std::ops::RangeInclusive<f32> = 0.005..=0.1;
 
 impl Recipe {
     /// Refuses what [`crate::make_garment`] never makes: a fit out of range, an edge length

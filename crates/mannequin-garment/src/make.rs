@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use mannequin_body::{BodyModel, shape_body};
-use mannequin_cloth::Material;
+use mannequin_cloth::{Material, check_garment};
 use mannequin_mesh::barycentric::plane_barycentric;
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::remesh::remesh;
@@ -96,6 +96,8 @@ pub fn make_garment(
         body_vertices: model.num_vertices(),
         body_faces: body.faces.len(),
     };
+    // A template is made to be simulated: one the solver cannot hold is not handed on.
+    check_garment(&mesh).map_err(|e| GarmentError::invalid("template", e.to_string()))?;
     let garment = Garment::bind(recipe, mesh.clone(), &surface);
     mesh.uv = body.uv.as_ref().map(|uv| carried_uvs(&garment, &rest, &body.faces, uv));
     Ok(Garment { mesh, ..garment })

@@ -54,7 +54,7 @@ pub struct MakeArgs {
     /// Sleeve length from shoulder (0) to wrist (1); the category's by default.
     #[arg(long)]
     sleeve: Option<f32>,
-    /// Target edge length of the triangles, metres.
+    /// Target edge length of the triangles, metres (0.005 to 0.1).
     #[arg(long, default_value_t = 0.015)]
     edge_length: f32,
     /// Cloth material; the category's by default.
