@@ -53,7 +53,7 @@ pub fn shape_body(model: &BodyModel, shape: &[f32]) -> Result<ShapedBody, BodyEr
             format!("{} coefficients given, the model has {n}", shape.len()),
         ));
     }
-    if let Some(i) = shape.iter().position(|x| !(f64::from(x.abs()) <= MAX_BETA)) {
+    if let Some(i) = shape.iter().position(|x| !x.is_finite() || f64::from(x.abs()) > MAX_BETA) {
         return Err(BodyError::input(
             "shape",
             format!("coefficient {i} is {}: expected a finite value within ±{MAX_BETA}", shape[i]),

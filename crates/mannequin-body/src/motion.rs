@@ -61,7 +61,7 @@ fn check_frames(npz: &Npz, key: &str, shape: &[usize]) -> Result<(), BodyError> 
 
 /// Shape coefficients, finite and within [`MAX_BETA`].
 fn check_betas(npz: &Npz, betas: &[f64]) -> Result<(), BodyError> {
-    match betas.iter().position(|b| !(b.abs() <= MAX_BETA)) {
+    match betas.iter().position(|b| !b.is_finite() || b.abs() > MAX_BETA) {
         Some(i) => Err(npz
             .field_error("betas", format!("element {i} is {}: expected within ±{MAX_BETA}", betas[i]))
             .into()),
@@ -72,7 +72,7 @@ fn check_betas(npz: &Npz, betas: &[f64]) -> Result<(), BodyError> {
 /// Every value finite and within `bound` (rotations need only be finite; a translation is held
 /// to [`MAX_DISTANCE`]).
 fn check_values(npz: &Npz, key: &str, values: &[f32], per_frame: usize, bound: f64) -> Result<(), BodyError> {
-    match values.iter().position(|x| !(f64::from(x.abs()) <= bound)) {
+    match values.iter().position(|x| !x.is_finite() || f64::from(x.abs()) > bound) {
         Some(i) => Err(npz
             .field_error(
                 key,

@@ -197,10 +197,13 @@ fn read_member(
     let header_end = npy::header_end(&buf)?;
     (&mut entry).take(header_end.saturating_sub(buf.len()) as u64).read_to_end(&mut buf)?;
     let (declared, shape) = npy::declared(&buf)?;
-    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).unwrap_or(usize::MAX);
+    // An element counts as at least 8 bytes' worth: one text element may declare 800 MB.
+    let data_bytes = declared.saturating_sub(header_end);
+    let count =
+        shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).unwrap_or(usize::MAX).max(data_bytes / 8);
     if count > MAX_ARRAY_ELEMENTS {
         return Err(MemberError::Npy(NpyError::Format(format!(
-            "shape {shape:?} holds {count} elements, expected at most {MAX_ARRAY_ELEMENTS}"
+            "shape {shape:?} ({data_bytes} bytes) holds {count} elements' worth, expected at most {MAX_ARRAY_ELEMENTS} (of 8 bytes)"
         ))));
     }
     *elements += count;
@@ -414,6 +417,11 @@ mod tests {
         let bytes = zipped(&[("a.npy", big.clone()), ("b.npy", big), ("c.npy", u8_header(1))]);
         let err = Npz::from_bytes("m.npz".into(), &bytes).unwrap_err().to_string();
         assert!(err.contains("'c'") && err.contains("in all"), "{err}");
+        let wide = write_npy(&NpyArray { shape: vec![1], data: NpyData::Str(vec!["x".repeat(70_000_000)]) });
+        let header_only = wide[..npy::header_end(&wide).unwrap()].to_vec();
+        let err =
+            Npz::from_bytes("t.npz".into(), &zipped(&[("run.npy", header_only)])).unwrap_err().to_string();
+        assert!(err.contains("'run'") && err.contains("bytes"), "{err}");
         let ok = zipped(&[("a.npy", write_npy(&NpyArray::f32(vec![2], vec![1.0, 2.0])))]);
         assert!(Npz::from_bytes("m.npz".into(), &ok).is_ok());
     }
