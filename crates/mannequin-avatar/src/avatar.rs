@@ -6,6 +6,7 @@ use std::path::Path;
 
 use burn::tensor::{Device, Tensor};
 use mannequin_body::{Rig, skin_tensors};
+use mannequin_data::FLOAT32;
 use mannequin_io::{NpyArray, Npz, NpzWriter, write_atomic};
 use mannequin_splat::{Camera, ColorTensor, RenderOptions, RotationTensor, sh, splat_render};
 
@@ -17,7 +18,7 @@ use crate::fused_binding::{self, BindConfig};
 use crate::host_ops;
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
-use crate::params::{ANY_FINITE, Param, tensor_from};
+use crate::params::{Param, tensor_from};
 use crate::sh_colour::{ColourConfig, colour_convention, sh_colour, sh_colour_tensors};
 use mannequin_data::rng::SplitMix64;
 
@@ -430,7 +431,7 @@ impl Avatar {
     /// Replaces every parameter with `{prefix}{name}` from `npz`.
     pub fn load_params(&mut self, npz: &Npz, prefix: &str) -> Result<(), AvatarError> {
         for p in &mut self.params {
-            p.load(npz, prefix, ANY_FINITE)?;
+            p.load(npz, prefix, FLOAT32)?;
         }
         Ok(())
     }

@@ -3,12 +3,13 @@
 //! trained avatar needs neither the body-model file nor the dataset again.
 
 use mannequin_body::{BodyModel, lbs::shape_body};
+use mannequin_data::FLOAT32;
+use mannequin_io::limits::MAX_DISTANCE;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;
 
 use crate::error::AvatarError;
 use crate::garment_layer::{BODY, GarmentLayer};
-use crate::params::ANY_FINITE;
 use crate::skirt_layer::{SkirtLayer, SkirtMode, fit_skirt};
 use crate::views::View;
 
@@ -155,25 +156,26 @@ impl Canonical {
     }
 
     /// Reads what [`Canonical::write`] wrote, checking every shape against the vertex and joint
-    /// counts and every value against its meaning: finite numbers, offset gates in [0, 1], faces
-    /// and parents that index what is there.
+    /// counts and every value against its meaning: float32 numbers, coordinates within
+    /// `MAX_DISTANCE` metres, offset gates in [0, 1], faces and parents that index what is there.
     pub fn read(npz: &Npz) -> Result<Self, AvatarError> {
         let f32s = |key: &str, shape: &[Option<usize>], allowed| -> Result<Vec<f32>, AvatarError> {
             let (_, d) = npz.f64_in_range(key, shape, allowed)?;
             Ok(d.into_iter().map(|x| x as f32).collect())
         };
-        let vertices = f32s("vertices", &[None, Some(3)], ANY_FINITE)?;
+        // The body at rest, in metres.
+        let vertices = f32s("vertices", &[None, Some(3)], -MAX_DISTANCE..=MAX_DISTANCE)?;
         let v = vertices.len() / 3;
-        let joints = f32s("joints", &[None, Some(3)], ANY_FINITE)?;
+        let joints = f32s("joints", &[None, Some(3)], -MAX_DISTANCE..=MAX_DISTANCE)?;
         let j = joints.len() / 3;
         if j == 0 {
             return Err(npz.field_error("joints", "expected at least one joint, found none").into());
         }
-        let weights = f32s("weights", &[Some(v), Some(j)], ANY_FINITE)?;
+        let weights = f32s("weights", &[Some(v), Some(j)], FLOAT32)?;
         // Pose correctives: none, or a row per rotation-matrix entry of every joint but the root.
         let none = npz.get("posedirs").is_some_and(|a| a.shape.first() == Some(&0));
         let rows = if none { 0 } else { 9 * (j - 1) };
-        let posedirs = f32s("posedirs", &[Some(rows), Some(3 * v)], ANY_FINITE)?;
+        let posedirs = f32s("posedirs", &[Some(rows), Some(3 * v)], FLOAT32)?;
         let (_, faces) = npz.f64_with_shape("faces", &[None, Some(3)])?;
         let (_, parents) = npz.f64_with_shape("parents", &[Some(j)])?;
         // Models saved before garment layers existed let the field move every vertex.

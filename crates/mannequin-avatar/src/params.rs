@@ -9,9 +9,6 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
 
-/// Any finite value, for [`Param::load`].
-pub const ANY_FINITE: RangeInclusive<f64> = f64::NEG_INFINITY..=f64::INFINITY;
-
 #[derive(Clone, Debug)]
 pub struct Param {
     pub name: String,

@@ -411,7 +411,8 @@ fn model_with(dir: &Path, key: &str, array: mannequin_io::NpyArray) -> PathBuf {
         w.add(k, npz.get(k).unwrap().clone());
     }
     w.add(key, array);
-    w.write(copy.join("avatar.npz")).unwrap();
+    // As bytes: the writer refuses the NaN these files are made of.
+    std::fs::write(copy.join("avatar.npz"), w.to_bytes()).unwrap();
     copy
 }
 

@@ -168,7 +168,7 @@ fn edit_checkpoint(checkpoint: &Path, key: &str, array: mannequin_io::NpyArray) 
         w.add(k, npz.get(k).unwrap().clone());
     }
     w.add(key, array);
-    w.write(checkpoint).unwrap();
+    std::fs::write(checkpoint, w.to_bytes()).unwrap();
 }
 
 /// A checkpoint edited by hand once resumed into a NaN avatar ("running PSNR NaN dB"): a
@@ -189,7 +189,7 @@ fn a_checkpoint_outside_the_run_is_refused_by_field() {
     let mut negative = moment.to_f32().unwrap();
     negative[1] = -0.25;
     for (key, array, expected) in [
-        (v.as_str(), NpyArray::f32(moment.shape.clone(), negative), "element 1 is -0.25: expected 0–inf"),
+        (v.as_str(), NpyArray::f32(moment.shape.clone(), negative), "element 1 is -0.25: expected 0–"),
         (
             "iteration",
             NpyArray::i64(vec![1], vec![-5]),
@@ -229,7 +229,8 @@ fn a_failing_run_leaves_no_model() {
         w.add(k, npz.get(k).unwrap().clone());
     }
     w.add("body_pose", body);
-    w.write(&poses).unwrap();
+    // As bytes: the writer refuses the NaN this file is made of.
+    std::fs::write(&poses, w.to_bytes()).unwrap();
     let out = dir.join("model");
     let base = ["train", "--data", s(&subject), "--out", s(&out), "--body", "default-lod1"];
     let o = command(&[&base[..], &["--iters", "4", "--checkpoint-every", "4"]].concat()).output().unwrap();

@@ -9,10 +9,11 @@ mod fused;
 mod kernels;
 
 use burn::tensor::{Gradients, Tensor};
+use mannequin_data::FLOAT32;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
-use crate::params::{ANY_FINITE, Param, to_npy};
+use crate::params::{Param, to_npy};
 use fused::Coefficients;
 
 /// First and second moment estimates per parameter, on the parameters' inner device.
@@ -64,7 +65,7 @@ impl Adam {
         adam.step = step;
         for (k, p) in params.iter().enumerate() {
             for (prefix, slot, allowed) in
-                [("adam_m/", &mut adam.m[k], ANY_FINITE), ("adam_v/", &mut adam.v[k], 0.0..=f64::INFINITY)]
+                [("adam_m/", &mut adam.m[k], FLOAT32), ("adam_v/", &mut adam.v[k], 0.0..=*FLOAT32.end())]
             {
                 let mut moment = Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
                 moment.load(npz, prefix, allowed)?;
