@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
+use mannequin_mesh::gltf::MAX_MORPH_FRAMES;
 use mannequin_mesh::{
     BlendShapeAnimation, BlendShapeMesh, MorphSequence, SkeletalAnimation, Skeleton, SkinnedLayer,
     SkinnedMesh, TriMesh, UvLayout, write_blend_shape_glb, write_glb, write_layered_glb, write_scene_glb,
@@ -683,6 +684,11 @@ fn vertex_cache_plays_back_from_the_file() {
     bad.frames[2].pop();
     let e = write_scene_glb(&path, &arm, None, &[bad]).unwrap_err().to_string();
     assert!(e.contains("sheet.frames[2]") && e.contains("9 vertices"), "{e}");
+    // Its weight keys grow with the square of the frames: a long cache is refused, not allocated.
+    let mut long = sheet.clone();
+    long.frames = vec![sheet.frames[0].clone(); MAX_MORPH_FRAMES + 1];
+    let e = write_scene_glb(&path, &arm, None, &[long]).unwrap_err().to_string();
+    assert!(e.ends_with("cache.glb: sheet.frames: 1 to 4096 frames, found 4097"), "{e}");
 }
 
 /// The validator and three.js on the arm with the cache beside it: three.js finds the morph mesh
