@@ -255,6 +255,27 @@ fn animate_renders_frames_and_video() {
     std::fs::remove_dir_all(out).unwrap();
 }
 
+/// --max-frames cuts the clip before it is resampled: a four-second walk at 30,000 fps would
+/// be 119,001 frames (past the motion limit) if resampled whole, and two are all that play.
+#[test]
+fn animate_resamples_only_the_frames_it_plays() {
+    let out = scratch("avatar-cli-animate-cut");
+    let walk = out.join("walk4.npz");
+    ok(mannequin(&["motion", "walk", "--seconds", "4", "-o", s(&walk)]));
+    let frames = out.join("frames");
+    let camera = out.join("camera.json");
+    std::fs::write(
+        &camera,
+        r#"{"K": [[60, 0, 16], [0, 60, 16], [0, 0, 1]], "extrinsic": [[1, 0, 0, 0], [0, -1, 0, 0.2],
+            [0, 0, -1, 4], [0, 0, 0, 1]], "width": 32, "height": 32}"#,
+    )
+    .unwrap();
+    let args = ["--fps", "30000", "--max-frames", "2", "--camera", s(&camera), "-o", s(&frames)];
+    ok(mannequin(&[&["animate", "--avatar", s(model()), "--motion", s(&walk)][..], &args].concat()));
+    assert!(frames.join("frame_0001.png").exists() && !frames.join("frame_0002.png").exists());
+    std::fs::remove_dir_all(out).unwrap();
+}
+
 #[test]
 fn bad_inputs_give_one_line_errors() {
     let out = scratch("avatar-cli-bad");
