@@ -19,7 +19,7 @@ fn crafted_inputs_are_refused_cleanly() {
     let cases_dir = root.join("cases");
     // MANNEQUIN_CRAFTED=inputs|cloth|avatar runs one area's cases alone, while working on it.
     let only = std::env::var("MANNEQUIN_CRAFTED").ok();
-    let areas: [(&str, fn(&Fixtures, &std::path::Path) -> Vec<Case>); 3] = [
+    let areas: [(&str, crafted::MakeCases); 3] = [
         ("inputs", crafted::inputs::cases),
         ("cloth", crafted::cloth::cases),
         ("avatar", crafted::avatar::cases),

@@ -376,16 +376,19 @@ fn amass(path: &Path, poses: NpyArray, trans: NpyArray, fps: f64, betas: Option<
     std::fs::write(path, w.to_bytes()).unwrap();
 }
 
+/// Writes a crafted file at the path given.
+type WriteFile = Box<dyn Fn(&Path)>;
+
 fn motion_cases(fx: &Fixtures, dir: &Path, cases: &mut Vec<Case>) {
     let zeros = |f: usize, w: usize| NpyArray::f32(vec![f, w], vec![0.0; f * w]);
-    let good_poses = || zeros(10, 66);
-    let good_trans = || zeros(10, 3);
+    let good_poses = move || zeros(10, 66);
+    let good_trans = move || zeros(10, 3);
     let with = |f: usize, w: usize, i: usize, v: f32| {
         let mut d = vec![0.0f32; f * w];
         d[i] = v;
         NpyArray::f32(vec![f, w], d)
     };
-    let mut motions: Vec<(String, Box<dyn Fn(&Path)>, &str)> = vec![
+    let mut motions: Vec<(String, WriteFile, &str)> = vec![
         (
             "two_million_frames".into(),
             Box::new(move |p| amass(p, zeros(2_000_000, 3), zeros(2_000_000, 3), 30.0, None)),

@@ -58,6 +58,9 @@ impl Case {
     }
 }
 
+/// How an area makes its cases: from the fixtures, into its own folder.
+pub type MakeCases = fn(&Fixtures, &Path) -> Vec<Case>;
+
 /// Good files every area starts from and mutates copies of. Read-only for cases: a case that
 /// writes must point its outputs into its own folder (the harness checks the fixtures are
 /// unchanged at the end).
