@@ -13,11 +13,11 @@ use mannequin_data::Image;
 use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
 use mannequin_fit::FaceModels;
 use mannequin_fit::body_fit::assumed_focal;
-use mannequin_io::limits::FOCAL_RANGE_PER_SIDE;
 use mannequin_fit::face_fit::{FaceFit, FaceFitter};
 use mannequin_fit::overlay::overlay;
 use mannequin_fit::pose_landmarker::PoseLandmarks;
 use mannequin_fit::{BodyFit, Person, PersonModels, fit_body, pick_person};
+use mannequin_io::limits::FOCAL_RANGE_PER_SIDE;
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
 

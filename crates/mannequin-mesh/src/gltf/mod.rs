@@ -13,7 +13,7 @@ mod morph;
 mod split;
 
 pub use blend_shapes::{BlendShapeAnimation, BlendShapeMesh, write_blend_shape_glb};
-pub use glb_check::check_glb;
 pub use document::{scene_glb_bytes, write_glb, write_layered_glb, write_scene_glb};
+pub use glb_check::check_glb;
 pub use model::{SkeletalAnimation, Skeleton, SkinnedLayer, SkinnedMesh};
 pub use morph::{MAX_MORPH_FRAMES, MorphSequence};
