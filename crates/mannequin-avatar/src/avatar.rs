@@ -6,7 +6,7 @@ use std::path::Path;
 
 use burn::tensor::{Device, Tensor};
 use mannequin_body::{Rig, skin_tensors};
-use mannequin_data::FLOAT32;
+use mannequin_io::limits::FLOAT32;
 use mannequin_io::{NpyArray, Npz, NpzWriter, write_atomic};
 use mannequin_splat::{Camera, ColorTensor, RenderOptions, RotationTensor, sh, splat_render};
 

@@ -3,7 +3,7 @@
 //! trained avatar needs neither the body-model file nor the dataset again.
 
 use mannequin_body::{BodyModel, lbs::shape_body};
-use mannequin_data::FLOAT32;
+use mannequin_io::limits::FLOAT32;
 use mannequin_io::limits::MAX_DISTANCE;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;

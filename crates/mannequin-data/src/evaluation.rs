@@ -26,9 +26,7 @@ use crate::metrics::lpips::Lpips;
 use crate::metrics::normal_error::normal_error;
 use crate::metrics::{psnr::psnr, ssim::ssim};
 
-/// Most surface samples per mesh the geometry metrics take: a million points and their k-d
-/// trees stay well under a gigabyte, and Chamfer distances settle to 0.01 cm long before.
-pub const MAX_SURFACE_SAMPLES: usize = 1_000_000;
+pub use mannequin_io::limits::MAX_SURFACE_SAMPLES;
 
 pub struct EvalOptions {
     pub background: [f32; 3],

@@ -21,10 +21,6 @@ pub mod splits;
 pub mod staged;
 pub mod writer;
 
-/// Every value a float32 holds, for [`mannequin_io::Npz::f64_in_range`]: an array read as
-/// float64 and computed in float32 refuses what would overflow to an infinity.
-pub const FLOAT32: std::ops::RangeInclusive<f64> = -(f32::MAX as f64)..=f32::MAX as f64;
-
 pub use dataset::{Cameras, Dataset, Frame, Split};
 pub use error::DataError;
 pub use fingerprint::Fingerprint;

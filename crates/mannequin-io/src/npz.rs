@@ -137,7 +137,8 @@ impl Npz {
         let (shape, v) = self.f64_with_shape(key, expected)?;
         match v.iter().position(|x| !x.is_finite()) {
             Some(i) => {
-                Err(self.field_error(key, format!("element {i} is {}: expected a finite number", v[i])))
+                Err(self
+                    .field_error(key, format!("element {i} is {}: expected a finite number", number(v[i]))))
             }
             None => Ok((shape, v)),
         }
@@ -154,11 +155,23 @@ impl Npz {
         match v.iter().position(|x| !range.contains(x)) {
             Some(i) => Err(self.field_error(
                 key,
-                format!("element {i} is {}: expected {}–{}", v[i], range.start(), range.end()),
+                format!(
+                    "element {i} is {}: expected {}–{}",
+                    number(v[i]),
+                    number(*range.start()),
+                    number(*range.end())
+                ),
             )),
             None => Ok((shape, v)),
         }
     }
+}
+
+/// A number as a message shows it: whole numbers plainly, the very large or small with an
+/// exponent (`1e300`, not 301 digits).
+fn number(x: f64) -> String {
+    let a = x.abs();
+    if a >= 1e15 || (a > 0.0 && a < 1e-4) { format!("{x:e}") } else { format!("{x}") }
 }
 
 /// Why a member could not be read: its compressed bytes, or its array's header.
@@ -459,6 +472,11 @@ mod tests {
             "{e}"
         );
         assert!(npz.f64_in_range("transl", &[None], -1e7..=1e7).is_ok());
+        let mut w = NpzWriter::new();
+        w.add("fx", NpyArray::f64(vec![1], vec![1e300]));
+        let npz = Npz::from_bytes("k.npz".into(), &w.to_bytes()).unwrap();
+        let e = npz.f64_in_range("fx", &[None], 0.0..=f64::from(f32::MAX)).unwrap_err().to_string();
+        assert!(e.contains("element 0 is 1e300: expected 0–3.4028234663852886e38"), "{e}");
     }
 
     #[test]

@@ -9,7 +9,7 @@ mod fused;
 mod kernels;
 
 use burn::tensor::{Gradients, Tensor};
-use mannequin_data::FLOAT32;
+use mannequin_io::limits::FLOAT32;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;

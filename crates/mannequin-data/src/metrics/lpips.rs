@@ -19,9 +19,9 @@ use faer::{Accum, MatMut, MatRef, Par};
 use mannequin_io::Npz;
 use rayon::prelude::*;
 
-use crate::FLOAT32;
 use crate::error::DataError;
 use crate::image::Image;
+use mannequin_io::limits::FLOAT32;
 
 /// One AlexNet `features` convolution: key prefix, output and input channels, kernel size,
 /// stride, padding, and whether a 3×3/2 max-pool comes before it.
