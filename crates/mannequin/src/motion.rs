@@ -43,11 +43,21 @@ pub struct Clip {
     #[arg(long)]
     pub motion: PathBuf,
     /// Resample the motion to this frame rate (default: the file's own).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_fps)]
     pub fps: Option<f32>,
     /// Use only the first N frames (after resampling).
     #[arg(long)]
     pub max_frames: Option<usize>,
+}
+
+/// A frame rate: a positive, finite number, refused by the parser naming `--fps` (a negative
+/// one was taken for a flag).
+fn parse_fps(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(fps) if fps.is_finite() && fps > 0.0 => Ok(fps),
+        Ok(fps) => Err(format!("{fps}: expected a positive number of frames per second")),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 /// Keeps the first `n` frames of `motion` (all, if it has fewer).

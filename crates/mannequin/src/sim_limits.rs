@@ -4,6 +4,7 @@
 
 use anyhow::{Result, bail};
 use mannequin_body::settling::MAX_SETTLE_SECONDS;
+use mannequin_mesh::gltf::MAX_MORPH_FRAMES;
 
 /// Most solver substeps per frame: the default is 20, and past 100 a frame costs seconds
 /// without draping differently.
@@ -25,8 +26,17 @@ pub fn parse_settle(text: &str) -> Result<f32, String> {
 }
 
 /// Refuses a run that would hold `frames` frames of `vertices` positions past
-/// [`MAX_KEPT_POSITIONS`], naming the motion and how to shorten it.
+/// [`MAX_KEPT_POSITIONS`], or play more frames than a `.glb` point cache holds
+/// ([`MAX_MORPH_FRAMES`]), naming the motion and how to shorten it: before any simulating, not
+/// when the scene is written after it.
 pub fn check_kept_positions(motion: &std::path::Path, frames: usize, vertices: usize) -> Result<()> {
+    if frames > MAX_MORPH_FRAMES {
+        bail!(
+            "{}: {frames} frames; the scene's point cache holds at most {MAX_MORPH_FRAMES}: \
+             shorten the clip with --max-frames or --settle",
+            motion.display()
+        );
+    }
     let kept = frames.saturating_mul(vertices);
     if kept > MAX_KEPT_POSITIONS {
         bail!(
@@ -50,5 +60,15 @@ mod tests {
             assert!(parse_settle(bad).unwrap_err().contains("expected 0 to 10 seconds"), "{bad}");
         }
         assert!(parse_settle("x").is_err());
+    }
+
+    #[test]
+    fn a_run_is_held_to_the_positions_it_keeps_and_the_frames_a_scene_holds() {
+        let walk = std::path::Path::new("walk.npz");
+        assert!(check_kept_positions(walk, MAX_MORPH_FRAMES, 100).is_ok());
+        let e = check_kept_positions(walk, MAX_MORPH_FRAMES + 1, 1).unwrap_err().to_string();
+        assert!(e.starts_with("walk.npz: 4097 frames") && e.contains("--max-frames"), "{e}");
+        let e = check_kept_positions(walk, 1000, 20_000).unwrap_err().to_string();
+        assert!(e.contains("20000000 positions"), "{e}");
     }
 }

@@ -6,10 +6,9 @@
 use std::path::Path;
 
 use mannequin_data::metrics::lpips::weight_shapes;
-use mannequin_data::rng::SplitMix64;
 use mannequin_io::{NpyArray, NpyData, Npz, NpzWriter};
 
-use super::{Case, Fixtures, case_dir};
+use super::{Case, Fixtures, broken_bytes, case_dir};
 use crate::common::s;
 
 /// One way to spoil an array: its name in case names, the array put in its place (`None`:
@@ -84,13 +83,6 @@ fn write_with(npz: &Npz, to: &Path, key: &str, array: Option<&NpyArray>) {
     std::fs::write(to, w.to_bytes()).unwrap();
 }
 
-/// Whole-file damage: the first half of `bytes`, noise, nothing.
-fn broken_files(bytes: &[u8]) -> [(&'static str, Vec<u8>); 3] {
-    let mut rng = SplitMix64::new(42);
-    let noise = (0..4096).map(|_| rng.next_u64() as u8).collect();
-    [("truncated", bytes[..bytes.len() / 2].to_vec()), ("noise", noise), ("empty", Vec::new())]
-}
-
 /// `avatar.npz` cases: each spoiled copy is loaded by one of the verbs that read an avatar, in
 /// turn, writing into the case's folder.
 fn avatar_cases(fx: &Fixtures, dir: &Path) -> Vec<Case> {
@@ -162,7 +154,7 @@ fn avatar_cases(fx: &Fixtures, dir: &Path) -> Vec<Case> {
         let needle = format!("'{key}'");
         add(name, &|to| write_with(&npz, to, key, array.as_ref()), &["avatar.npz", &needle, says]);
     }
-    for (how, bytes) in broken_files(&base) {
+    for (how, bytes) in broken_bytes(&base) {
         for k in 0..3 {
             let write = |to: &Path| std::fs::write(to, &bytes).unwrap();
             add(format!("avatar.npz/{how}/{k}"), &write, &["avatar.npz", "not a readable .npz archive"]);
@@ -277,7 +269,7 @@ fn checkpoint_cases(fx: &Fixtures, dir: &Path) -> Vec<Case> {
         let write = |to: &Path| write_with(&npz, to, key, array.as_ref());
         add(name, &write, &[&["checkpoint.npz", says.as_str(), "--restart"][..], needles].concat());
     }
-    for (how, bytes) in broken_files(&std::fs::read(&path).unwrap()) {
+    for (how, bytes) in broken_bytes(&std::fs::read(&path).unwrap()) {
         let write = |to: &Path| std::fs::write(to, &bytes).unwrap();
         add(format!("file/{how}"), &write, &["checkpoint.npz", "not a readable .npz archive"]);
     }
@@ -326,7 +318,7 @@ fn lpips_cases(fx: &Fixtures, dir: &Path) -> Vec<Case> {
     write(&dir.join("lpips-good.npz"), "", None);
     bytes.extend(std::fs::read(dir.join("lpips-good.npz")).unwrap());
     std::fs::remove_file(dir.join("lpips-good.npz")).unwrap();
-    for (how, broken) in broken_files(&bytes) {
+    for (how, broken) in broken_bytes(&bytes) {
         let fill = |to: &Path| std::fs::write(to, &broken).unwrap();
         add(format!("file/{how}"), &fill, &["alex.npz", "not a readable .npz archive"]);
     }
@@ -416,8 +408,9 @@ fn flag_cases(fx: &Fixtures, dir: &Path) -> Vec<Case> {
     };
     for (name, extra, usage, says) in [
         ("max-frames-0", &["--max-frames", "0"][..], false, "--max-frames"),
-        ("fps-0", &["--fps", "0"], false, "frame rate"),
-        ("fps-nan", &["--fps", "nan"], false, "frame rate"),
+        ("fps-0", &["--fps", "0"], true, "--fps"),
+        ("fps-nan", &["--fps", "nan"], true, "--fps"),
+        ("fps-negative", &["--fps", "-5"], true, "--fps"),
         ("fps-huge", &["--fps", "1e9"], false, "frame rate"),
         ("what-unknown", &["--what", "x-ray"], true, "x-ray"),
     ] {

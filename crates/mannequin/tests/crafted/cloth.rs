@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use mannequin_body::BodyModel;
 use mannequin_io::{NpyArray, Npz};
 
-use super::{Case, Fixtures, case_dir};
+use super::{Case, Fixtures, broken_bytes, case_dir};
 use crate::common::{mannequin, s};
 
 /// The good files every case breaks a copy of.
@@ -140,25 +140,6 @@ fn band_obj() -> String {
     text
 }
 
-/// Random bytes, an empty file, and `good` cut short at a tenth, half and nine tenths.
-fn broken_bytes(good: &[u8]) -> Vec<(String, Vec<u8>)> {
-    let mut out = vec![("empty".to_string(), Vec::new())];
-    for share in [10, 50, 90] {
-        out.push((format!("cut_{share}"), good[..good.len() * share / 100].to_vec()));
-    }
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let random = (0..good.len().max(64))
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state as u8
-        })
-        .collect();
-    out.push(("random".to_string(), random));
-    out
-}
-
 /// `cloth simulate` of the garment `garment` (and pins), writing into `case/out`.
 fn simulate(fx: &Fixtures, case: &Path, garment: &Path, pins: Option<&Path>, extra: &[&str]) -> Vec<String> {
     let mut a: Vec<String> = ["cloth", "simulate", "--garment", s(garment), "--motion", s(&fx.motion)]
@@ -277,15 +258,17 @@ fn flag_cases(fx: &Fixtures, dir: &Path, base: &Base, cases: &mut Vec<Case>) {
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     cases.push(Case::usage("cloth/flags/cloth_material", &case, &args, &["--material", "vibranium"]));
     // The clip's flags, as these verbs take them.
-    let clip: [(&str, &str, &str); 5] = [
-        ("--fps", "0", "frame rate"),
-        ("--fps", "inf", "frame rate"),
-        ("--fps", "NaN", "frame rate"),
-        ("--fps", "1e9", "expected at most 1000 times"),
-        ("--max-frames", "0", "--max-frames"),
+    // (flag, value, what the refusal names, whether the parser itself refuses it)
+    let clip: [(&str, &str, &str, bool); 6] = [
+        ("--fps", "0", "--fps", true),
+        ("--fps", "inf", "--fps", true),
+        ("--fps", "NaN", "--fps", true),
+        ("--fps", "-5", "--fps", true),
+        ("--fps", "1e9", "expected at most 1000 times", false),
+        ("--max-frames", "0", "--max-frames", false),
     ];
     for verb in ["cloth", "dress"] {
-        for (flag, value, needle) in clip {
+        for (flag, value, needle, by_parser) in clip {
             let name = format!("flags/{verb}_{}_{value}", &flag[2..]);
             let case = folder(dir, &name);
             let extra = ["--body", "default-lod1", flag, value];
@@ -293,7 +276,12 @@ fn flag_cases(fx: &Fixtures, dir: &Path, base: &Base, cases: &mut Vec<Case>) {
                 "cloth" => simulate(fx, &case, &base.band, None, &extra),
                 _ => dress(fx, &case, &base.tshirt, &extra),
             };
-            cases.push(refused(&name, &case, &args, &[needle]));
+            if by_parser {
+                let args: Vec<&str> = args.iter().map(String::as_str).collect();
+                cases.push(Case::usage(format!("cloth/{name}"), &case, &args, &[needle]));
+            } else {
+                cases.push(refused(&name, &case, &args, &[needle]));
+            }
         }
     }
     // A settling period within the flag's limit is refused by the frames it makes at a rate no

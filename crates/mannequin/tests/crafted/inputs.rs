@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use mannequin_io::{NpyArray, NpyData, Npz, NpzWriter};
 
-use super::{Case, Fixtures, case_dir, copy_dir, npz_with};
+use super::{Case, Fixtures, broken_bytes, case_dir, copy_dir, npz_with};
 use crate::common::s;
 
 /// Values that break a number field, with the word the refusal must hold where it names one.
@@ -264,25 +264,6 @@ fn dataset_cases(fx: &Fixtures, dir: &Path, cases: &mut Vec<Case>) {
             ));
         }
     }
-}
-
-/// A file's bytes broken the ways files break: emptied, cut short at several places, random.
-fn broken_bytes(good: &[u8]) -> Vec<(String, Vec<u8>)> {
-    let mut out = vec![("empty".to_string(), Vec::new())];
-    for share in [10, 50, 90] {
-        out.push((format!("cut_{share}"), good[..good.len() * share / 100].to_vec()));
-    }
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let random: Vec<u8> = (0..good.len().max(64))
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state as u8
-        })
-        .collect();
-    out.push(("random".to_string(), random));
-    out
 }
 
 /// A PNG whose header claims `w`×`h`, followed by a few bytes of image data: what a decoder

@@ -93,6 +93,18 @@ pub fn case_dir(dir: &Path, name: &str) -> PathBuf {
     d
 }
 
+/// A good file's bytes broken the ways files break: emptied, cut short at a tenth, a half and
+/// nine tenths, and replaced by noise as long.
+pub fn broken_bytes(good: &[u8]) -> Vec<(String, Vec<u8>)> {
+    let mut out = vec![("empty".to_string(), Vec::new())];
+    for share in [10, 50, 90] {
+        out.push((format!("cut_{share}"), good[..good.len() * share / 100].to_vec()));
+    }
+    let mut rng = mannequin_data::rng::SplitMix64::new(42);
+    out.push(("random".to_string(), (0..good.len().max(64)).map(|_| rng.next_u64() as u8).collect()));
+    out
+}
+
 /// Copies the folder `from` to `to` (files and subfolders), for a case that mutates a fixture.
 pub fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
