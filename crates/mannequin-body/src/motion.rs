@@ -69,20 +69,25 @@ fn check_betas(npz: &Npz, betas: &[f64]) -> Result<(), BodyError> {
     }
 }
 
-/// Every value finite and within `bound` (rotations need only be finite; a translation is held
-/// to [`MAX_DISTANCE`]).
-fn check_values(npz: &Npz, key: &str, values: &[f32], per_frame: usize, bound: f64) -> Result<(), BodyError> {
-    match values.iter().position(|x| !x.is_finite() || f64::from(x.abs()) > bound) {
-        Some(i) => Err(npz
-            .field_error(
-                key,
-                format!(
-                    "frame {} holds {}: expected a finite value within ±{bound}",
-                    i / per_frame.max(1),
-                    values[i]
-                ),
-            )
-            .into()),
+/// Every value finite and within `bound` where there is one (rotations need only be finite; a
+/// translation is held to [`MAX_DISTANCE`]).
+fn check_values(
+    npz: &Npz,
+    key: &str,
+    values: &[f32],
+    per_frame: usize,
+    bound: Option<f64>,
+) -> Result<(), BodyError> {
+    let within = |x: f32| x.is_finite() && bound.is_none_or(|b| f64::from(x.abs()) <= b);
+    match values.iter().position(|&x| !within(x)) {
+        Some(i) => {
+            let expected =
+                bound.map_or("a finite value".to_string(), |b| format!("a finite value within ±{b}"));
+            let frame = i / per_frame.max(1);
+            Err(npz
+                .field_error(key, format!("frame {frame} holds {}: expected {expected}", values[i]))
+                .into())
+        }
         None => Ok(()),
     }
 }
@@ -129,8 +134,8 @@ impl Motion {
         };
         let poses: Vec<f32> = poses.into_iter().map(|x| x as f32).collect();
         let trans: Vec<f32> = trans.into_iter().map(|x| x as f32).collect();
-        check_values(npz, "poses", &poses, width, f64::from(f32::MAX))?;
-        check_values(npz, "trans", &trans, 3, MAX_DISTANCE)?;
+        check_values(npz, "poses", &poses, width, None)?;
+        check_values(npz, "trans", &trans, 3, Some(MAX_DISTANCE))?;
         Ok(Self {
             source: npz.path.clone(),
             poses,
@@ -157,8 +162,8 @@ impl Motion {
             poses.extend(body[69 * f..69 * f + 69].iter().map(|&x| x as f32));
         }
         let trans: Vec<f32> = transl.iter().map(|&x| x as f32).collect();
-        check_values(npz, "global_orient/body_pose", &poses, 72, f64::from(f32::MAX))?;
-        check_values(npz, "transl", &trans, 3, MAX_DISTANCE)?;
+        check_values(npz, "global_orient/body_pose", &poses, 72, None)?;
+        check_values(npz, "transl", &trans, 3, Some(MAX_DISTANCE))?;
         Ok(Self {
             source: npz.path.clone(),
             poses,
