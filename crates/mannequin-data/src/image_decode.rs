@@ -10,7 +10,7 @@ use zune_jpeg::zune_core::bytestream::ZCursor;
 use zune_jpeg::zune_core::colorspace::ColorSpace;
 use zune_jpeg::zune_core::options::DecoderOptions;
 
-use mannequin_io::limits::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+use mannequin_io::limits::check_image_size;
 
 use crate::error::DataError;
 use crate::image::Image;
@@ -48,19 +48,14 @@ fn describe_start(bytes: &[u8]) -> String {
     format!("bytes {}", head.join(" "))
 }
 
-/// Refuses an image whose header claims more than [`MAX_IMAGE_SIDE`] a side or
-/// [`MAX_IMAGE_PIXELS`] in all, before its pixels are allocated: a 74-byte PNG may claim
-/// 65535×65535.
+/// Refuses an image whose header claims no pixels, or more than
+/// [`mannequin_io::limits::check_image_size`] allows, before its pixels are allocated: a
+/// 74-byte PNG may claim 65535×65535.
 pub(crate) fn check_size(path: &Path, width: usize, height: usize) -> Result<(), DataError> {
-    if width == 0 || height == 0 || width.max(height) > MAX_IMAGE_SIDE || width * height > MAX_IMAGE_PIXELS {
-        return Err(DataError::file(
-            path,
-            format!(
-                "image size {width}×{height}: expected at most {MAX_IMAGE_SIDE} a side and {MAX_IMAGE_PIXELS} pixels"
-            ),
-        ));
+    if width == 0 || height == 0 {
+        return Err(DataError::file(path, format!("image size {width}×{height} is empty")));
     }
-    Ok(())
+    check_image_size(width, height).map_err(|e| DataError::file(path, e))
 }
 
 impl Image {

@@ -17,6 +17,17 @@ pub const MAX_IMAGE_PIXELS: usize = 4096 * 4096;
 /// Longest image or camera side, in pixels (a panorama's width within [`MAX_IMAGE_PIXELS`]).
 pub const MAX_IMAGE_SIDE: usize = 16384;
 
+/// Refuses an image or camera size past [`MAX_IMAGE_SIDE`] or [`MAX_IMAGE_PIXELS`], in the words
+/// every reader of a size uses.
+pub fn check_image_size(width: usize, height: usize) -> Result<(), String> {
+    if width.max(height) > MAX_IMAGE_SIDE || width.saturating_mul(height) > MAX_IMAGE_PIXELS {
+        return Err(format!(
+            "image size {width}×{height}: expected at most {MAX_IMAGE_SIDE} a side and {MAX_IMAGE_PIXELS} pixels"
+        ));
+    }
+    Ok(())
+}
+
 /// Frames in one motion file: 100,000 is 55 minutes at 30 fps (AMASS's longest takes are a few
 /// minutes at 120 fps).
 pub const MAX_MOTION_FRAMES: usize = 100_000;

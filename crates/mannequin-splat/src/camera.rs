@@ -5,7 +5,7 @@
 use glam::{DMat3, DVec3};
 
 use mannequin_io::limits::{
-    FOCAL_RANGE_PER_SIDE, MAX_DISTANCE, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_PRINCIPAL_OFFSET_SIDES,
+    FOCAL_RANGE_PER_SIDE, MAX_DISTANCE, MAX_PRINCIPAL_OFFSET_SIDES, check_image_size,
 };
 
 use crate::SplatError;
@@ -132,11 +132,8 @@ impl Camera {
         if self.width == 0 || self.height == 0 {
             return err(format!("image size {}×{} is empty", self.width, self.height));
         }
-        if self.width.max(self.height) > MAX_IMAGE_SIDE || self.width * self.height > MAX_IMAGE_PIXELS {
-            return err(format!(
-                "image size {}×{}: expected at most {MAX_IMAGE_SIDE} a side and {MAX_IMAGE_PIXELS} pixels",
-                self.width, self.height
-            ));
+        if let Err(e) = check_image_size(self.width, self.height) {
+            return err(e);
         }
         let k = &self.intrinsic;
         if k.iter().flatten().any(|v| !v.is_finite()) {
