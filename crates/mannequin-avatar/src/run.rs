@@ -1,21 +1,15 @@
-//! The record of a training run: every setting that changes what it produces. A checkpoint
-//! stores it (as JSON text), and resuming compares it leaf by leaf, so a resume with different
-//! settings or data is refused naming the setting instead of silently mixing two runs.
-
-use std::collections::{BTreeMap, BTreeSet};
+//! The record of a training run: every setting that changes what it produces, kept in the
+//! checkpoint as every run's record is ([`mannequin_io::run_record`]).
 
 use mannequin_data::fingerprint::Fingerprint;
-use mannequin_io::{NpyArray, Npz, NpzWriter};
+use mannequin_io::run_record::{check_run, write_run};
+use mannequin_io::{Npz, NpzWriter};
 use serde::Serialize;
-use serde_json::Value;
 
 use crate::config::AvatarConfig;
 use crate::error::AvatarError;
 use crate::skirt_layer::SkirtMode;
 use crate::trainer::TrainOptions;
-
-/// Checkpoint member that holds the record.
-const MEMBER: &str = "run";
 
 /// What `mannequin train` was asked for, beyond the avatar and the loss settings: the body, the
 /// data and how they are read.
@@ -43,65 +37,16 @@ pub struct GarmentRecord {
     pub steps: usize,
 }
 
-/// Every leaf of `value` by its dotted path, as text (strings unquoted).
-fn leaves(path: &str, value: &Value, out: &mut BTreeMap<String, String>) {
-    match value {
-        Value::Object(map) => {
-            for (key, v) in map {
-                let child = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
-                leaves(&child, v, out);
-            }
-        }
-        Value::String(s) => {
-            out.insert(path.to_string(), s.clone());
-        }
-        _ => {
-            out.insert(path.to_string(), value.to_string());
-        }
-    }
-}
-
-/// The leaves of a JSON text; text that is not JSON has none.
-fn parse_leaves(json: &str) -> Option<BTreeMap<String, String>> {
-    let mut out = BTreeMap::new();
-    leaves("", &serde_json::from_str(json).ok()?, &mut out);
-    Some(out)
-}
-
 impl TrainingRun {
-    fn to_json(&self) -> String {
-        serde_json::to_string(self).expect("the record serialises")
-    }
-
     /// Stores the record in a checkpoint being written.
     pub fn write(&self, w: &mut NpzWriter) {
-        w.add(MEMBER, NpyArray::text(&self.to_json()));
+        write_run(w, self);
     }
 
     /// Refuses `checkpoint` unless its record matches `self` in every setting but `undecided`
-    /// (ones the caller cannot know yet), naming each differing setting with both values. Both
-    /// sides are read back from JSON text, so floats compare exactly as stored.
+    /// (ones the caller cannot know yet), naming each differing setting with both values.
     pub fn check(&self, checkpoint: &Npz, undecided: &[&str]) -> Result<(), AvatarError> {
-        if !checkpoint.contains(MEMBER) {
-            let reason = "holds no record of its run (written by an older mannequin)";
-            return Err(AvatarError::file(&checkpoint.path, reason));
-        }
-        let recorded = parse_leaves(checkpoint.text(MEMBER)?)
-            .ok_or_else(|| checkpoint.field_error(MEMBER, "expected the run's settings as JSON"))?;
-        let now = parse_leaves(&self.to_json()).expect("the record is JSON");
-        let names: BTreeSet<&String> = recorded.keys().chain(now.keys()).collect();
-        let text =
-            |m: &BTreeMap<String, String>, k: &str| m.get(k).map_or("(none)", String::as_str).to_string();
-        let differences: Vec<String> = names
-            .into_iter()
-            .filter(|k| !undecided.contains(&k.as_str()) && recorded.get(*k) != now.get(*k))
-            .map(|k| format!("{k} was {}, now {}", text(&recorded, k), text(&now, k)))
-            .collect();
-        if differences.is_empty() {
-            return Ok(());
-        }
-        let reason = format!("a checkpoint of another run: {}", differences.join(", "));
-        Err(AvatarError::file(&checkpoint.path, reason))
+        Ok(check_run(checkpoint, self, undecided)?)
     }
 }
 

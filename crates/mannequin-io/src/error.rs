@@ -30,4 +30,7 @@ pub enum IoError {
     MissingKey { path: PathBuf, key: String, present: String },
     #[error("{path}: field '{key}': {reason}")]
     Field { path: PathBuf, key: String, reason: String },
+    /// A checkpoint that cannot resume this run (another run's, or one without a record).
+    #[error("{path}: {reason}")]
+    Checkpoint { path: PathBuf, reason: String },
 }

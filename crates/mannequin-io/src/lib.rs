@@ -1,5 +1,6 @@
 //! File plumbing shared by every Mannequin crate: NumPy arrays (in `.npy`, `.npz`, or pickled),
-//! PLY headers and values, atomic writes, and the limits on what any reader accepts.
+//! PLY headers and values, atomic writes, the limits on what any reader accepts, checkpoint run
+//! records and progress bars.
 
 pub mod atomic;
 pub mod error;
@@ -10,6 +11,8 @@ pub mod pickle;
 pub mod pickle_arrays;
 pub mod ply_body;
 pub mod ply_header;
+pub mod progress;
+pub mod run_record;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use error::{IoError, NpyError, PickleError};

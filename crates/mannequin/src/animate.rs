@@ -12,9 +12,9 @@ use mannequin_body::Motion;
 use mannequin_splat::Camera;
 
 use crate::motion::Clip;
-use crate::progress::{JobTimer, bar};
 use crate::render::{Map, box_centre, front_camera, write_map};
 use crate::splat::read_camera;
+use mannequin_io::progress::{JobTimer, bar};
 
 #[derive(ClapArgs)]
 #[command(

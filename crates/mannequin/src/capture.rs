@@ -24,8 +24,8 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use crate::body::load_body;
 use crate::checkpoint::{CHECKPOINT, add_run, check_run};
 use crate::fit::{FitArgs, check_picture, posed_mesh};
-use crate::progress::{JobTimer, bar};
 use crate::video_input::{Frames, VideoArgs};
+use mannequin_io::progress::{JobTimer, bar};
 
 /// The last tenth of the frames (at least one) is held out as the test split.
 const TEST_SHARE: usize = 10;

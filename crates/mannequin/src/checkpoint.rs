@@ -3,12 +3,11 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use mannequin_cloth::{ClothState, check_positions};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::points;
 use serde::Serialize;
-use serde::de::DeserializeOwned;
 
 /// The checkpoint's file name in a command's output folder.
 pub const CHECKPOINT: &str = "checkpoint.npz";
@@ -19,32 +18,16 @@ pub fn file_hash(path: &Path) -> Result<String> {
     Ok(mannequin_data::fingerprint::hash_bytes(&bytes))
 }
 
-/// Stores `run` (everything that changes the result) as the checkpoint's "run" entry.
+/// Stores `run` (everything that changes the result) as the checkpoint's record.
 pub fn add_run<T: Serialize>(w: &mut NpzWriter, run: &T) -> Result<()> {
-    w.add("run", NpyArray::text(&serde_json::to_string(run)?));
+    mannequin_io::run_record::write_run(w, run);
     Ok(())
 }
 
-/// Refuses a checkpoint whose "run" entry is not `run`, naming the settings that differ.
-pub fn check_run<T: Serialize + DeserializeOwned + PartialEq>(npz: &Npz, path: &Path, run: &T) -> Result<()> {
-    let recorded: T = serde_json::from_str(npz.text("run")?)
-        .with_context(|| format!("{}: run: expected the run's settings as JSON", path.display()))?;
-    if &recorded == run {
-        return Ok(());
-    }
-    let (was, now) = (serde_json::to_value(&recorded)?, serde_json::to_value(run)?);
-    let differ: Vec<String> = now
-        .as_object()
-        .into_iter()
-        .flatten()
-        .filter(|(k, v)| was.get(k.as_str()) != Some(v))
-        .map(|(k, v)| format!("{k} was {}, now {v}", was[k.as_str()]))
-        .collect();
-    bail!(
-        "{}: a checkpoint of another run: {}; use --restart to start over, or another --out",
-        path.display(),
-        differ.join(", ")
-    )
+/// Refuses a checkpoint whose record is not `run`, naming the settings that differ.
+pub fn check_run<T: Serialize>(npz: &Npz, _path: &Path, run: &T) -> Result<()> {
+    mannequin_io::run_record::check_run(npz, run, &[])
+        .map_err(|e| anyhow!("{e}; use --restart to start over, or another --out"))
 }
 
 /// `frames` (each of `vertices` points) as one [frames, vertices, 3] array.

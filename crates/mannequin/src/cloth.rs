@@ -23,9 +23,9 @@ use crate::checkpoint::{
     CHECKPOINT, add_run, add_state, check_run, file_hash, frames_array, read_frames, read_state,
 };
 use crate::motion::Clip;
-use crate::progress::{JobTimer, bar};
 use crate::sim_limits::{MAX_SUBSTEPS, check_kept_positions, parse_settle};
 use crate::staging::Staging;
+use mannequin_io::progress::{JobTimer, bar};
 
 #[derive(Subcommand)]
 pub enum ClothCommand {

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args as ClapArgs, Parser};
 
-use crate::progress::{JobTimer, set_stage};
+use mannequin_io::progress::{JobTimer, set_stage};
 
 #[derive(ClapArgs)]
 pub struct Args {

@@ -12,7 +12,7 @@ use mannequin_data::evaluation::{EvalOptions, MAX_SURFACE_SAMPLES, evaluate, tes
 use mannequin_data::metrics::lpips::Lpips;
 use mannequin_data::{Scores, TestSet};
 
-use crate::progress::{JobTimer, bar};
+use mannequin_io::progress::{JobTimer, bar};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -14,7 +14,7 @@ use mannequin_mesh::gltf::{SkeletalAnimation, scene_glb_bytes};
 
 use crate::body::write_mesh;
 use crate::pose_choice::PoseChoice;
-use crate::progress::JobTimer;
+use mannequin_io::progress::JobTimer;
 
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("outputs").required(true).multiple(true).args(["output", "gaussians", "skinned_gaussians"]))]

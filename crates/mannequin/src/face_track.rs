@@ -27,8 +27,8 @@ use crate::animate::write_video;
 use crate::checkpoint::{CHECKPOINT, add_run, check_run};
 use crate::face::{MIN_FACE_PX, check_face_body, expression_shapes, fitted_head, head_mesh, projected_edges};
 use crate::fit::FitArgs;
-use crate::progress::{JobTimer, bar};
 use crate::video_input::{Frames, VideoArgs};
+use mannequin_io::progress::{JobTimer, bar};
 
 /// Frames whose full fits are averaged into the video's face shape.
 const SHAPE_FRAMES: usize = 5;

@@ -20,7 +20,7 @@ use mannequin_mesh::{MorphSequence, TriMesh};
 
 use crate::body::load_body;
 use crate::dress::{load_or_make, write_layered_scene};
-use crate::progress::{JobTimer, bar};
+use mannequin_io::progress::{JobTimer, bar};
 
 /// Below this mean mask IoU over the first pass through the frames, the category is probably not
 /// the garment in the label maps (the right template starts near 0.7).

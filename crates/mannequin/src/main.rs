@@ -17,9 +17,9 @@ mod fit;
 mod garment;
 mod garment_fit;
 mod garment_layers;
+mod logging;
 mod motion;
 mod pose_choice;
-mod progress;
 mod render;
 mod sim_limits;
 mod splat;
@@ -118,7 +118,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    progress::init_logging(cli.verbose);
+    logging::init_logging(cli.verbose);
     match dispatch(cli.command) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

@@ -11,8 +11,8 @@ use mannequin_data::{Dataset, Image};
 use mannequin_splat::Camera;
 
 use crate::pose_choice::PoseChoice;
-use crate::progress::JobTimer;
 use crate::splat::read_camera;
+use mannequin_io::progress::JobTimer;
 
 /// What a render writes.
 #[derive(Clone, Copy, clap::ValueEnum)]

@@ -10,7 +10,7 @@ use anyhow::Context;
 use mannequin_splat::{Camera, RenderOptions, SplatScene, render};
 use serde_json::{Value, json};
 
-use crate::progress::JobTimer;
+use mannequin_io::progress::JobTimer;
 
 #[derive(clap::Args)]
 pub struct Args {

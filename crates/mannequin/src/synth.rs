@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use mannequin_body::BodyModel;
 use mannequin_synth::{SynthOptions, generate};
 
-use crate::progress::{JobTimer, bar};
+use mannequin_io::progress::{JobTimer, bar};
 
 #[derive(clap::Args)]
 pub struct Args {

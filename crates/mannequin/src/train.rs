@@ -16,7 +16,7 @@ use mannequin_data::{Dataset, Fingerprint};
 
 use crate::compute::Compute;
 use crate::garment_layers;
-use crate::progress::{JobTimer, bar};
+use mannequin_io::progress::{JobTimer, bar};
 
 #[derive(ClapArgs, Clone)]
 pub struct Args {

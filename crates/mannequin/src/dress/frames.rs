@@ -12,7 +12,7 @@ use mannequin_splat::Camera;
 use rayon::prelude::*;
 
 use crate::animate::{clip_camera, write_video};
-use crate::progress::bar;
+use mannequin_io::progress::bar;
 
 /// Skin's colour, linear RGB.
 const SKIN: [f32; 3] = [0.8, 0.6, 0.5];

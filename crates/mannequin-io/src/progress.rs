@@ -1,26 +1,11 @@
-//! Logging and progress display shared by every verb: `tracing` for logs, `indicatif` for bars,
-//! and a closing line with wall time and peak memory for long jobs.
+//! Progress display for long work, shared by every pipeline and the command line: `indicatif`
+//! bars (labelled with the stage of a multi-stage job) and a closing line with wall time and
+//! peak memory. Bars hide themselves when stderr is not a terminal.
 
 use std::sync::Mutex;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-
-pub fn init_logging(verbose: u8) {
-    let default = match verbose {
-        0 => "info",
-        1 => "debug",
-        _ => "trace",
-    };
-    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
-    tracing_subscriber::fmt()
-        .with_env_filter(filter)
-        .with_writer(std::io::stderr)
-        .with_target(false)
-        .without_time()
-        .init();
-}
 
 /// The stage of a multi-stage job (the demo), shown before every bar.
 static STAGE: Mutex<String> = Mutex::new(String::new());
