@@ -38,7 +38,7 @@ impl Category {
             .iter()
             .position(|&n| n == name)
             .map(|i| Category::ALL[i])
-            .ok_or_else(|| GarmentError::UnknownCategory { name: name.to_string() })
+            .ok_or_else(|| GarmentError::UnknownCategory { name: name.to_string(), known: &CATEGORY_NAMES })
     }
 
     pub fn name(self) -> &'static str {

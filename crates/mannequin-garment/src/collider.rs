@@ -7,7 +7,9 @@ use std::collections::HashSet;
 
 use mannequin_mesh::TriMesh;
 
-use crate::wear::Layer;
+/// A layer under the one being simulated: its triangles, and its positions at every frame of
+/// the schedule.
+pub(crate) type Layer<'a> = (&'a [[u32; 3]], &'a [Vec<[f32; 3]>]);
 
 /// A body triangle is kept when a corner comes within this far (m) of the skinned layer, give or
 /// take half again (the test is by cells of half this side): cloth hangs and swings a few

@@ -2,10 +2,12 @@
 
 #[derive(Debug, thiserror::Error)]
 pub enum GarmentError {
-    #[error("category: unknown name {name:?}; the categories are {}", crate::category::CATEGORY_NAMES.join(", "))]
-    UnknownCategory { name: String },
-    #[error("size: unknown name {name:?}; the sizes are {}", crate::fit::SIZE_NAMES.join(", "))]
-    UnknownSize { name: String },
+    /// `known`: the names there are.
+    #[error("category: unknown name {name:?}; the categories are {}", known.join(", "))]
+    UnknownCategory { name: String, known: &'static [&'static str] },
+    /// `known`: the names there are.
+    #[error("size: unknown name {name:?}; the sizes are {}", known.join(", "))]
+    UnknownSize { name: String, known: &'static [&'static str] },
     #[error("{field}: {reason}")]
     Invalid { field: String, reason: String },
     #[error("{path}: {reason}")]

@@ -11,14 +11,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::category::Category;
 use crate::error::GarmentError;
-use crate::fit::Fit;
+use crate::ease::Ease;
 
 /// How the template was made: enough to make it again on another body model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Recipe {
     pub category: Category,
-    pub fit: Fit,
+    pub fit: Ease,
     /// Target edge length of the remeshed garment (m).
     pub edge_length: f32,
     /// A `mannequin-cloth` material name.
@@ -156,7 +156,7 @@ mod tests {
         let garment_points = vec![[0.2, 0.3, 0.05], [0.7, 0.1, 0.02], [0.5, 0.9, 0.1]];
         let recipe = Recipe {
             category: Category::Tshirt,
-            fit: Fit::size("M").unwrap(),
+            fit: Ease::size("M").unwrap(),
             edge_length: 0.015,
             material: "cotton".into(),
             body: "square".into(),

@@ -51,13 +51,13 @@ impl Garment {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Category, Fit, Recipe};
+    use crate::{Category, Ease, Recipe};
     use mannequin_mesh::{SurfacePoint, TriMesh};
 
     fn hanging(model: &BodyModel, faces_hung: &[u32], offset: f32) -> Garment {
         let recipe = Recipe {
             category: Category::Tshirt,
-            fit: Fit::size("M").unwrap(),
+            fit: Ease::size("M").unwrap(),
             edge_length: 0.015,
             material: "cotton".into(),
             body: "test".into(),

@@ -5,11 +5,10 @@
 pub mod category;
 mod collider;
 mod drape;
+pub mod ease;
 mod error;
 pub mod file;
-pub mod fit;
 mod garment;
-pub mod jacobian_fit;
 mod layering;
 mod make;
 pub mod ngd;
@@ -20,8 +19,8 @@ mod transfer;
 mod wear;
 
 pub use category::{CATEGORY_NAMES, Category};
+pub use ease::{Ease, SIZE_NAMES};
 pub use error::GarmentError;
-pub use fit::{Fit, SIZE_NAMES};
 pub use garment::{Garment, Recipe};
 pub use make::{TEMPLATE_REVISION, make_garment};
 pub use transfer::Dressed;

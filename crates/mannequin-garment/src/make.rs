@@ -13,7 +13,7 @@ use mannequin_mesh::{ClosestPoint, TriMesh, UvLayout};
 
 use crate::category::Category;
 use crate::error::GarmentError;
-use crate::fit::Fit;
+use crate::ease::Ease;
 use crate::garment::{Garment, Recipe, check_edge_length};
 use crate::region::{Landmarks, covered_region, open_front};
 use crate::sewing::sew_skirt;
@@ -32,7 +32,7 @@ const SEWN_REMESH_ROUNDS: usize = 3;
 /// `body_name`) with shape `betas`, in `material`.
 pub fn make_garment(
     category: Category,
-    fit: Fit,
+    fit: Ease,
     edge_length: f32,
     material: &str,
     model: &BodyModel,

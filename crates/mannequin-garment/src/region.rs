@@ -10,7 +10,7 @@ use mannequin_mesh::TriMesh;
 use mannequin_mesh::clip::clip;
 
 use crate::category::Category;
-use crate::fit::Fit;
+use crate::ease::Ease;
 
 /// Cut vertices closer than this to a cut count as on it (m): no slivers thinner than 1 mm.
 const SNAP: f32 = 1e-3;
@@ -82,13 +82,13 @@ impl Landmarks {
     }
 
     /// The hem's rest height.
-    pub fn hem(&self, category: Category, fit: &Fit) -> f32 {
+    pub fn hem(&self, category: Category, fit: &Ease) -> f32 {
         self.floor + fit.hem_height.unwrap_or_else(|| self.default_hem_height(category))
     }
 
     /// The ease at rest height `y`: the fit's hip, waist and chest values, linear between those
     /// heights and constant beyond them.
-    pub fn ease_at(&self, fit: &Fit, y: f32) -> f32 {
+    pub fn ease_at(&self, fit: &Ease, y: f32) -> f32 {
         let knots = [(self.hips, fit.ease_hips), (self.waist, fit.ease_waist), (self.chest, fit.ease_chest)];
         if y <= knots[0].0 {
             return knots[0].1;
@@ -105,7 +105,7 @@ impl Landmarks {
 
 /// The part of the rest `body` mesh the garment covers (largest connected piece); for a
 /// category that hangs free below the seat, the part above it.
-pub fn covered_region(body: &TriMesh, marks: &Landmarks, category: Category, fit: &Fit) -> TriMesh {
+pub fn covered_region(body: &TriMesh, marks: &Landmarks, category: Category, fit: &Ease) -> TriMesh {
     let hem = marks.hem(category, fit).max(if category.flare().is_some() { marks.seat() } else { f32::MIN });
     let mut region = body.clone();
     region.uv = None;

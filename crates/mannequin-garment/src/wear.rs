@@ -9,13 +9,9 @@ use mannequin_cloth::{Attachment, Body, Cloth, ClothState, Material, PhaseTimes,
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::adjacency::boundary_loops_by_height;
 
-use crate::collider::Collider;
+use crate::collider::{Collider, Layer};
 use crate::error::GarmentError;
 use crate::transfer::Dressed;
-
-/// A layer under the one being simulated: its triangles, and its positions at every frame of
-/// the schedule.
-pub(crate) type Layer<'a> = (&'a [[u32; 3]], &'a [Vec<[f32; 3]>]);
 
 /// The body the layers are worn on: its triangles, and its vertices at every frame of
 /// `schedule`, which plays at `fps`.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use mannequin_body::{BodyModel, shape_body};
 use mannequin_garment::file::{read_garment, write_garment};
-use mannequin_garment::{Category, Fit, Garment, Recipe};
+use mannequin_garment::{Category, Ease, Garment, Recipe};
 use mannequin_io::{NpyArray, NpyData, Npz, NpzWriter};
 use mannequin_mesh::{ClosestPoint, TriMesh};
 
@@ -23,7 +23,7 @@ fn square_garment() -> Garment {
     );
     let recipe = Recipe {
         category: Category::Tshirt,
-        fit: Fit::size("M").unwrap(),
+        fit: Ease::size("M").unwrap(),
         edge_length: 0.015,
         material: "cotton".into(),
         body: "default-lod1".into(),

@@ -4,7 +4,7 @@
 //! against smplx; with betas, the transfer (Eq. 3.2) must follow the shape too.
 
 use mannequin_body::{BodyModel, Motion, forward};
-use mannequin_garment::{Category, Dressed, Fit, Garment, Recipe};
+use mannequin_garment::{Category, Dressed, Ease, Garment, Recipe};
 use mannequin_mesh::SurfacePoint;
 
 #[test]
@@ -21,7 +21,7 @@ fn the_body_as_a_garment_poses_as_the_body() {
     }
     let recipe = Recipe {
         category: Category::Tshirt,
-        fit: Fit::size("M").unwrap(),
+        fit: Ease::size("M").unwrap(),
         edge_length: 0.015,
         material: "cotton".into(),
         body: "default-lod1".into(),

@@ -8,7 +8,7 @@ use mannequin_body::smpl_joint::PELVIS;
 use mannequin_body::{BodyModel, shape_body};
 use mannequin_cloth::quality::{self_intersecting_pairs, vertices_inside_body};
 use mannequin_garment::region::Landmarks;
-use mannequin_garment::{Category, Dressed, Fit, Garment, make_garment};
+use mannequin_garment::{Category, Dressed, Ease, Garment, make_garment};
 use mannequin_mesh::adjacency::{boundary_loops, edges};
 use mannequin_mesh::{ClosestPoint, TriMesh};
 
@@ -73,7 +73,7 @@ fn check_template(category: Category, openings: usize, size: &str, loose_below: 
     let model = BodyModel::default_body();
     let body = model.template_mesh();
     let index = ClosestPoint::new(&body.positions, &body.faces, 0.03);
-    let fit = Fit::size(size).unwrap();
+    let fit = Ease::size(size).unwrap();
     let name = format!("{} {size}", category.name());
     let name = name.as_str();
     let target = 0.015;

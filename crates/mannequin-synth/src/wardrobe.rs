@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 use mannequin_body::BodyModel;
 use mannequin_data::error::DataError;
-use mannequin_garment::{Category, Fit, Garment, make_garment};
+use mannequin_garment::{Category, Ease, Garment, make_garment};
 use mannequin_mesh::{TriMesh, UvLayout};
 
 use crate::subject::Outfit;
@@ -53,7 +53,7 @@ pub fn dress_subject(model: &BodyModel, betas: &[f32], outfit: Outfit) -> Result
         let fail = |e: mannequin_garment::GarmentError| {
             DataError::Invalid(format!("making the {}: {e}", category.name()))
         };
-        let fit = Fit::size(size).map_err(fail)?;
+        let fit = Ease::size(size).map_err(fail)?;
         let made = make_garment(category, fit, EDGE, category.default_material(), model, "default", betas)
             .map_err(fail)?;
         let inner: Vec<&Garment> = worn.iter().map(|w| &w.garment).collect();

@@ -12,7 +12,7 @@ use mannequin_body::{BodyModel, Settling, shape_body, skeletal_animation, skinne
 use mannequin_cloth::{Material, Settings, quality};
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{
-    Category, Dressed, Fit, Garment, LayerProgress, SIZE_NAMES, TEMPLATE_REVISION, WearProgress, WearStep,
+    Category, Dressed, Ease, Garment, LayerProgress, SIZE_NAMES, TEMPLATE_REVISION, WearProgress, WearStep,
     Wearer, make_garment, wear,
 };
 use mannequin_io::{Npz, NpzWriter};
@@ -451,7 +451,7 @@ pub(crate) fn load_or_make(
     }
     let start = Instant::now();
     let garment =
-        make_garment(category, Fit::size(size)?, 0.015, category.default_material(), model, body, &[])?;
+        make_garment(category, Ease::size(size)?, 0.015, category.default_material(), model, body, &[])?;
     tracing::info!("{}: made in {:.1} s", category.name(), start.elapsed().as_secs_f64());
     if let Some(path) = &cache {
         let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(anyhow::Error::from);

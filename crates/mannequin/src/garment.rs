@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use mannequin_cloth::{MATERIAL_NAMES, Material};
 use mannequin_garment::file::{read_garment, write_garment};
-use mannequin_garment::{CATEGORY_NAMES, Category, Fit, Garment, SIZE_NAMES, make_garment};
+use mannequin_garment::{CATEGORY_NAMES, Category, Ease, Garment, SIZE_NAMES, make_garment};
 use mannequin_mesh::write_obj;
 
 use crate::body::{BodyArgs, load_body};
@@ -80,7 +80,7 @@ pub fn run(cmd: GarmentCommand) -> Result<()> {
 
 fn make(args: MakeArgs) -> Result<()> {
     let category = Category::named(&args.category)?;
-    let mut fit = Fit::size(&args.size)?;
+    let mut fit = Ease::size(&args.size)?;
     fit.ease_chest = args.ease_chest.unwrap_or(fit.ease_chest);
     fit.ease_waist = args.ease_waist.unwrap_or(fit.ease_waist);
     fit.ease_hips = args.ease_hips.unwrap_or(fit.ease_hips);

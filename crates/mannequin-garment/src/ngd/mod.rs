@@ -7,6 +7,7 @@ mod pose_code;
 mod reconstruction;
 mod remesh;
 mod scene;
+mod static_field;
 mod target;
 
 pub use loss::{LossParts, LossWeights, image_loss};

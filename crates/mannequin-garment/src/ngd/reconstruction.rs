@@ -15,9 +15,9 @@ use super::loss::{LossParts, LossWeights, image_loss};
 use super::pose_code::PoseCode;
 use super::remesh::{RemeshSchedule, remesh_and_carry, selected_edges};
 use super::scene::{FramePose, Scene};
+use super::static_field::StaticField;
 use super::target::Target;
 use crate::error::GarmentError;
-use crate::jacobian_fit::JacobianFieldFit;
 use crate::transfer::Dressed;
 
 /// The optimisation's settings; NGD's terms can each be switched off for the ablations.
@@ -113,7 +113,7 @@ pub struct Reconstruction<'a> {
     base: Vec<[f32; 3]>,
     faces: Vec<[u32; 3]>,
     weights: Vec<f32>,
-    field: JacobianFieldFit,
+    field: StaticField,
     /// The dynamic field and the pose code it reads, if the settings ask for one.
     dynamic: Option<(DynamicField, PoseCode)>,
     settings: Settings,
@@ -134,7 +134,7 @@ impl<'a> Reconstruction<'a> {
         let rest = dressed.rest();
         let faces = dressed.garment().mesh.faces.clone();
         check_manifold(&rest, &faces).map_err(|e| GarmentError::invalid("base garment", e.to_string()))?;
-        let field = JacobianFieldFit::new(&rest, &faces)
+        let field = StaticField::new(&rest, &faces)
             .map_err(|e| GarmentError::invalid("base garment", e.to_string()))?;
         let dynamic = settings.dynamic.as_ref().map(|d| {
             let code = PoseCode::fit(

@@ -8,7 +8,7 @@ use crate::error::GarmentError;
 /// A garment's size and cut, in metres except `sleeve`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Fit {
+pub struct Ease {
     pub ease_chest: f32,
     pub ease_waist: f32,
     pub ease_hips: f32,
@@ -21,14 +21,14 @@ pub struct Fit {
 /// The names `--size` takes.
 pub const SIZE_NAMES: [&str; 4] = ["S", "M", "L", "XL"];
 
-impl Fit {
+impl Ease {
     /// A size's ease: M stands about 1.5 cm off the chest, each size up adds about 1 cm.
-    pub fn size(name: &str) -> Result<Fit, GarmentError> {
+    pub fn size(name: &str) -> Result<Ease, GarmentError> {
         let step = SIZE_NAMES
             .iter()
             .position(|&n| n.eq_ignore_ascii_case(name))
-            .ok_or_else(|| GarmentError::UnknownSize { name: name.to_string() })? as f32;
-        Ok(Fit {
+            .ok_or_else(|| GarmentError::UnknownSize { name: name.to_string(), known: &SIZE_NAMES })? as f32;
+        Ok(Ease {
             ease_chest: 0.005 + 0.01 * step,
             ease_waist: 0.004 + 0.008 * step,
             ease_hips: 0.004 + 0.008 * step,

@@ -2,7 +2,8 @@
 //! Jacobians (J'_t = M_t J_t), the Poisson solve integrates them into positions, and Adam moves the
 //! field down the gradient a loss on those positions sends back, with the Jacobian regulariser
 //! λ Σ_t ‖M_t − I‖² pulling toward the base shape. This is NGD's static field J^s; the dynamic
-//! field (an MLP on pose) is not here yet.
+//! field J^D (`dynamic_field.rs`, an MLP on pose) adds to it per pose through
+//! [`StaticField::positions_with`], and shares the gradient [`StaticField::step`] returns.
 
 use mannequin_mesh::MeshError;
 use mannequin_mesh::jacobian_field::{deform, deform_backward, rest_jacobians};
@@ -13,7 +14,7 @@ const BETA1: f64 = 0.9;
 const BETA2: f64 = 0.999;
 
 /// The field, its solver and Adam's moments.
-pub struct JacobianFieldFit {
+pub struct StaticField {
     solve: PoissonSolve,
     jacobians: Vec<Jacobian>,
     pinned: usize,
@@ -27,7 +28,7 @@ pub struct JacobianFieldFit {
     gradient_norms: Vec<f64>,
 }
 
-impl JacobianFieldFit {
+impl StaticField {
     /// The identity field on the base garment `rest`/`faces`; the vertex nearest the centroid is
     /// pinned where it is (the gradients do not fix a translation).
     pub fn new(rest: &[[f32; 3]], faces: &[[u32; 3]]) -> Result<Self, MeshError> {
