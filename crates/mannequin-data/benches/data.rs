@@ -1,18 +1,15 @@
-//! `cargo bench -p mannequin-data --bench data`: metric throughput at 540×540 (frames/s),
-//! ground-truth rendering and synthetic-subject generation, each against a baseline measured in
-//! the same run, so the printed ratios do not depend on the machine.
+//! `cargo bench -p mannequin-data --bench data`: metric throughput at 540×540 (frames/s), each
+//! against a baseline measured in the same run, so the printed ratios do not depend on the
+//! machine. (Ground-truth rendering is timed by `mannequin-raster`'s bench, synthetic-subject
+//! generation by `mannequin-synth`'s.)
 //!
 //! - SSIM: the separable, parallel implementation against the direct 11×11 window, one thread.
 //! - PSNR + SSIM per frame; LPIPS (AlexNet, random weights) and the geometry metrics
 //!   (100k samples per mesh) on all threads against one.
-//! - Rasterizer: a ~13k-vertex mesh at 540², all threads against one.
-//! - `mannequin synth` with default settings (176 frames at 540²), timed once, and a short
-//!   capture on all threads against one.
 
 use std::time::Instant;
 
-use mannequin_body::BodyModel;
-use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_data::Image;
 use mannequin_data::metrics::geometry::geometry_metrics;
 use mannequin_data::metrics::lpips::{Lpips, weight_shapes};
 use mannequin_data::metrics::{
@@ -20,10 +17,8 @@ use mannequin_data::metrics::{
     ssim::{ssim, ssim_direct},
 };
 use mannequin_data::rng::SplitMix64;
-use mannequin_data::{Camera, Image};
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
-use mannequin_synth::{SynthOptions, generate};
 
 const SIZE: usize = 540;
 
@@ -39,21 +34,14 @@ fn noisy_pair(seed: u64) -> (Image, Image) {
     (Image { width: SIZE, height: SIZE, pixels: a }, Image { width: SIZE, height: SIZE, pixels: b })
 }
 
-/// Seconds per call of `f`, over `n` calls after `warm_up` untimed ones.
-fn time_after<T>(warm_up: usize, n: usize, mut f: impl FnMut() -> T) -> f64 {
-    for _ in 0..warm_up {
-        std::hint::black_box(f());
-    }
+/// Seconds per call of `f`, over `n` calls after one warm-up.
+fn time<T>(n: usize, mut f: impl FnMut() -> T) -> f64 {
+    std::hint::black_box(f());
     let t = Instant::now();
     for _ in 0..n {
         std::hint::black_box(f());
     }
     t.elapsed().as_secs_f64() / n as f64
-}
-
-/// Seconds per call of `f`, over `n` calls after one warm-up.
-fn time<T>(n: usize, f: impl FnMut() -> T) -> f64 {
-    time_after(1, n, f)
 }
 
 fn sphere(rings: usize, segments: usize) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
@@ -116,21 +104,6 @@ fn main() {
     let both = time(10, || (psnr(&a, &b), ssim(&a, &b)));
     println!("PSNR + SSIM per frame       : {:8.1} frames/s", 1.0 / both);
 
-    let (pos, faces) = sphere(90, 144);
-    let normals = mannequin_mesh::normals::vertex_normals(&pos, &faces);
-    let mesh =
-        RasterMesh { positions: &pos, faces: &faces, normals: &normals, shading: Shading::Flat([0.8; 3]) };
-    let cam = Camera::look_at([0.0, 0.0, 2.5], [0.0; 3], [0.0, 1.0, 0.0], 0.8, SIZE, SIZE);
-    let r1 = single.install(|| time(5, || rasterize(&mesh, &cam, [1.0; 3])));
-    let rn = time(20, || rasterize(&mesh, &cam, [1.0; 3]));
-    println!(
-        "rasterize {}k vertices, 1 thread: {:7.1} frames/s; {threads} threads: {:7.1} frames/s ({:.1}×)",
-        pos.len() / 1000,
-        1.0 / r1,
-        1.0 / rn,
-        r1 / rn
-    );
-
     let lpips = random_lpips();
     let l1 = single.install(|| time(1, || lpips.distance(&a, &b)));
     let ln = time(3, || lpips.distance(&a, &b));
@@ -141,6 +114,7 @@ fn main() {
         l1 / ln
     );
 
+    let (pos, faces) = sphere(90, 144);
     let gt = TriMesh::new(pos.clone(), faces.clone());
     let pred = TriMesh::new(pos.iter().map(|p| [p[0] * 1.01, p[1], p[2] + 0.003]).collect(), faces.clone());
     let g1 = single.install(|| time(1, || geometry_metrics(&pred, &gt, 100_000, 0)));
@@ -151,30 +125,4 @@ fn main() {
         gn,
         g1 / gn
     );
-
-    let model = BodyModel::default_body();
-    let dir = std::env::temp_dir().join(format!("mq-bench-synth-{}", std::process::id()));
-    let short = SynthOptions {
-        capture_frames: 12,
-        train_frames: 8,
-        view_poses: 2,
-        motion_frames: 2,
-        ..SynthOptions::default()
-    };
-    let frames = short.total_frames() as f64;
-    let s1 = single
-        .install(|| time_after(0, 1, || generate(&model, &dir, &short, &|| {}).expect("synthetic subject")));
-    let sn = time_after(0, 1, || generate(&model, &dir, &short, &|| {}).expect("synthetic subject"));
-    println!(
-        "synth, {} frames: 1 thread {:.1} frames/s; {threads} threads {:.1} frames/s ({:.1}×)",
-        frames,
-        frames / s1,
-        frames / sn,
-        s1 / sn
-    );
-    let full = SynthOptions::default();
-    let t = Instant::now();
-    generate(&model, &dir, &full, &|| {}).expect("synthetic subject");
-    println!("synth default ({} frames at {SIZE}²): {:.1} s", full.total_frames(), t.elapsed().as_secs_f64());
-    let _ = std::fs::remove_dir_all(dir);
 }

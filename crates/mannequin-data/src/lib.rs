@@ -1,8 +1,7 @@
-//! Datasets, ground truth and metrics: the PeopleSnapshot-layout reader and writer, a CPU mesh
-//! rasterizer for ground-truth images, synthetic subjects, and the metrics the papers report.
+//! Datasets and their metrics: the PeopleSnapshot-layout reader and writer, the images and maps
+//! a dataset holds, and the metrics the papers report.
 
 pub mod dataset;
-pub mod diff_raster;
 pub mod error;
 pub mod evaluation;
 pub mod fingerprint;
@@ -12,7 +11,6 @@ pub mod image_decode;
 pub mod labels;
 pub mod layout;
 pub mod maps;
-pub mod mesh_raster;
 pub mod metrics;
 pub mod poses;
 pub mod rng;

@@ -567,7 +567,7 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
 
 #[cfg(test)]
 mod tests {
-    use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+    use mannequin_raster::{RasterMesh, Shading, rasterize};
 
     use super::*;
     use crate::crop::RotatedRect;

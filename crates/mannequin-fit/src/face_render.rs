@@ -3,7 +3,7 @@
 //! truth is known.
 
 use glam::{DVec3, Vec3};
-use mannequin_data::mesh_raster::{Raster, RasterMesh, Shading, rasterize};
+use mannequin_raster::{Raster, RasterMesh, Shading, rasterize};
 use mannequin_data::{Camera, Image};
 use mannequin_mesh::normals::vertex_normals;
 

@@ -15,7 +15,7 @@
 //! differentiable rasteriser.
 
 use glam::DVec3;
-use mannequin_data::mesh_raster::{NO_FACE, RasterMesh, Shading, rasterize};
+use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 use mannequin_data::{Camera, Image};
 use mannequin_mesh::normals::vertex_normals;
 

@@ -3,7 +3,7 @@
 //! the fitted camera (red), each tied to its detection by a thin line.
 
 use mannequin_data::Image;
-use mannequin_data::mesh_raster::Raster;
+use mannequin_raster::Raster;
 
 use crate::blazepose::BONES;
 

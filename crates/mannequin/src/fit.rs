@@ -10,7 +10,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use mannequin_body::{BodyModel, FaceModel, forward, skeletal_animation, skinned_body};
 use mannequin_data::Image;
-use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_raster::{RasterMesh, Shading, rasterize};
 use mannequin_fit::FaceModels;
 use mannequin_fit::body_fit::assumed_focal;
 use mannequin_fit::face_fit::{FaceFit, FaceFitter};
@@ -215,7 +215,7 @@ pub fn posed_mesh(model: &BodyModel, fit: &BodyFit) -> Result<TriMesh> {
     Ok(mesh)
 }
 
-fn render(mesh: &TriMesh, fit: &BodyFit) -> mannequin_data::mesh_raster::Raster {
+fn render(mesh: &TriMesh, fit: &BodyFit) -> mannequin_raster::Raster {
     let normals = mannequin_mesh::normals::vertex_normals(&mesh.positions, &mesh.faces);
     let raster_mesh = RasterMesh {
         positions: &mesh.positions,

@@ -8,7 +8,7 @@
 use glam::{DVec3, Mat3A, Vec3A};
 use mannequin_body::forward;
 use mannequin_data::Camera;
-use mannequin_data::diff_raster::{Rendered, render};
+use mannequin_raster::differentiable::{Rendered, render};
 use mannequin_mesh::normals::{vertex_normals, vertex_normals_backward};
 
 use crate::error::GarmentError;

@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use mannequin_data::image::Image;
-use mannequin_data::mesh_raster::{RasterMesh, Shading, rasterize};
+use mannequin_raster::{RasterMesh, Shading, rasterize};
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_splat::Camera;
 use rayon::prelude::*;

@@ -10,9 +10,9 @@ use glam::{DMat3, DVec3, Vec2, Vec3};
 use mannequin_mesh::UvLayout;
 use rayon::prelude::*;
 
-use crate::Camera;
-use crate::image::{Image, Mask};
-use crate::maps::{DepthMap, NormalMap};
+use mannequin_data::image::{Image, Mask};
+use mannequin_data::maps::{DepthMap, NormalMap};
+use mannequin_splat::Camera;
 
 /// The face id of pixels that no triangle covers.
 pub const NO_FACE: u32 = u32::MAX;

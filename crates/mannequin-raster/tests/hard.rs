@@ -1,9 +1,9 @@
 //! The ground-truth rasterizer on scenes whose images are known in closed form.
 
 use glam::DVec3;
-use mannequin_data::mesh_raster::{NO_FACE, RasterMesh, Shading, rasterize, sample_bilinear};
 use mannequin_data::{Camera, Image};
 use mannequin_mesh::UvLayout;
+use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize, sample_bilinear};
 
 fn camera(w: usize, h: usize) -> Camera {
     // Slightly off-centre principal point and unequal focal lengths, to catch axis mix-ups.

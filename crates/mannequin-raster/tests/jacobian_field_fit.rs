@@ -5,9 +5,9 @@
 //! loss takes to its Jacobians.
 
 use mannequin_data::Camera;
-use mannequin_data::diff_raster::render;
 use mannequin_mesh::jacobian_field::{deform, deform_backward, rest_jacobians};
 use mannequin_mesh::poisson::{Jacobian, PoissonSolve};
+use mannequin_raster::differentiable::render;
 
 const SIDE: usize = 64;
 

@@ -19,8 +19,8 @@ use std::collections::HashMap;
 
 use glam::{DMat3, DVec3};
 
-use crate::Camera;
-use crate::mesh_raster::{NO_FACE, Raster, RasterMesh, Shading, rasterize};
+use crate::hard::{NO_FACE, Raster, RasterMesh, Shading, rasterize};
+use mannequin_splat::Camera;
 
 /// One antialiasing blend: pixel `to` gains `alpha` × (value at `from` − its own value).
 #[derive(Debug, Clone, Copy)]

@@ -2,8 +2,8 @@
 //! form (the antialiased coverage of a square is its area).
 
 use mannequin_data::Camera;
-use mannequin_data::diff_raster::render;
 use mannequin_data::rng::SplitMix64;
+use mannequin_raster::differentiable::render;
 
 fn camera(w: usize, h: usize) -> Camera {
     Camera::new(
@@ -114,8 +114,7 @@ fn antialiased_coverage_is_the_area() {
     let out = render(&positions, &faces, &attributes, &cam, [0.0]);
     let area = (90.0 * (x1 - x0) as f64 / z as f64) * (80.0 * (y1 - y0) as f64 / z as f64);
     let soft: f64 = out.image.iter().map(|p| p[0]).sum();
-    let hard =
-        out.raster.face_id.iter().filter(|&&f| f != mannequin_data::mesh_raster::NO_FACE).count() as f64;
+    let hard = out.raster.face_id.iter().filter(|&&f| f != mannequin_raster::NO_FACE).count() as f64;
     println!("area {area:.3} px², antialiased {soft:.3}, hard {hard}");
     assert!((soft - area).abs() < 0.02 * area, "antialiased coverage {soft} vs area {area}");
     assert!((soft - area).abs() < (hard - area).abs(), "antialiasing should beat the hard count");
