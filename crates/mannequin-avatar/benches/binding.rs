@@ -32,8 +32,7 @@ fn main() {
     let flat: Vec<f32> = model.v_template.iter().flatten().copied().collect();
     let vertices = || Tensor::<2>::from_data(TensorData::new(flat.clone(), [nv, 3]), &device).require_grad();
     let index = MeshIndex::new(nv, &model.faces, &device);
-    let config =
-        BindConfig { topology: index.topology.clone(), face_gaussians: true, vertex_gaussians: true };
+    let config = BindConfig { mesh: index.mesh.clone(), face_gaussians: true, vertex_gaussians: true };
     println!("binding {} faces + {nv} vertices, median of {REPS} (ms):", model.faces.len());
     let time = |what: &str, fused: &mut dyn FnMut(), tensors: &mut dyn FnMut()| {
         let (ours, _) = timing::median_and_min_ms(REPS, fused);

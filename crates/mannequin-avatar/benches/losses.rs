@@ -19,7 +19,9 @@ use timing::median_and_min_ms;
 use burn::tensor::module::conv2d;
 use burn::tensor::ops::ConvOptions;
 use burn::tensor::{Device, Tensor, TensorData};
-use mannequin_avatar::losses::{MeshTopology, gaussian_blur_valid, gaussian_window, ssim, ssim_with_blur};
+use mannequin_avatar::losses::{
+    MeshRegularisers, gaussian_blur_valid, gaussian_window, ssim, ssim_with_blur,
+};
 use mannequin_body::BodyModel;
 use mannequin_data::rng::SplitMix64;
 
@@ -124,7 +126,7 @@ fn ssim_section(reps: usize, device: &Device) {
 fn mesh_section(reps: usize, device: &Device) {
     let body = BodyModel::default_body();
     let topology =
-        MeshTopology::new(body.num_vertices(), &body.faces, device).expect("the default body's faces");
+        MeshRegularisers::new(body.num_vertices(), &body.faces, device).expect("the default body's faces");
     let mut rng = SplitMix64::new(3);
     let v: Vec<f32> = body.v_template.iter().flatten().map(|&c| c + 0.002 * rng.normal() as f32).collect();
     let vertices = [Tensor::<2>::from_data(TensorData::new(v, [body.num_vertices(), 3]), device)];

@@ -8,7 +8,7 @@
 use burn::tensor::{Tensor, TensorData};
 use mannequin_splat::Camera;
 
-use crate::avatar::rotation_transposed;
+use crate::camera_rotation::rotation_transposed;
 use crate::mesh_gaussians::GaussianGeometry;
 
 /// Smallest compensation kept differentiable (a degenerate footprint has det Σ₂ = 0).

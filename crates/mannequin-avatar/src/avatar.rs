@@ -10,6 +10,8 @@ use mannequin_io::limits::FLOAT32;
 use mannequin_io::{NpyArray, Npz, NpzWriter, write_atomic};
 use mannequin_splat::{Camera, ColorTensor, RenderOptions, RotationTensor, sh, splat_render};
 
+use crate::antialias;
+use crate::camera_rotation::rotation_transposed;
 use crate::canonical::Canonical;
 use crate::config::{AvatarConfig, Method};
 use crate::error::AvatarError;
@@ -99,14 +101,6 @@ impl Rendered {
     pub fn normals(&self) -> Tensor<3> {
         self.image.clone().narrow(0, 3, 3)
     }
-}
-
-/// The camera's world→camera rotation transposed, [3, 3]: rows of world vectors times it are
-/// camera-space vectors.
-pub(crate) fn rotation_transposed(camera: &Camera, device: &Device) -> Tensor<2> {
-    let e = &camera.extrinsic;
-    let rt: Vec<f32> = (0..3).flat_map(|i| (0..3).map(move |j| e[j][i] as f32)).collect();
-    tensor_from(rt, 3, 3, device)
 }
 
 fn flat(v: &[[f32; 3]]) -> Vec<f32> {
@@ -280,7 +274,7 @@ impl Avatar {
             Method::Tavatar => {
                 let mut g = if host_ops::supported(&self.device) {
                     let config = BindConfig {
-                        topology: self.index.topology.clone(),
+                        mesh: self.index.mesh.clone(),
                         face_gaussians: self.config.face_gaussians,
                         vertex_gaussians: self.config.vertex_gaussians,
                     };
@@ -367,7 +361,7 @@ impl Avatar {
             ..RenderOptions::default()
         };
         let opacities = if self.config.antialiased {
-            crate::antialias::compensation(g, camera, self.config.dilation)
+            antialias::compensation(g, camera, self.config.dilation)
         } else {
             Tensor::<1>::ones([n], &self.device)
         };

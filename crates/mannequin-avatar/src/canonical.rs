@@ -9,15 +9,16 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::subdivide::Subdivision;
 
 use crate::error::AvatarError;
-use crate::garment_layer::{BODY, GarmentLayer};
-use crate::skirt_layer::{SkirtLayer, SkirtMode, fit_skirt};
-use crate::views::View;
+
+/// The name of layer 0, the body; garment layers ([`crate::garment_layer`]) follow it.
+pub const BODY: &str = "body";
 
 /// Most midpoint subdivisions of a subject's mesh: each quadruples the faces (each a Gaussian or
 /// two), and three already make 64 times the template's.
 pub const MAX_SUBDIVISIONS: usize = 3;
 
-fn check_subdivisions(subdivisions: usize) -> Result<(), AvatarError> {
+/// Refuses more than [`MAX_SUBDIVISIONS`].
+pub(crate) fn check_subdivisions(subdivisions: usize) -> Result<(), AvatarError> {
     if subdivisions > MAX_SUBDIVISIONS {
         let reason = format!("{subdivisions} subdivisions (expected at most {MAX_SUBDIVISIONS})");
         return Err(AvatarError::Invalid(reason));
@@ -66,34 +67,6 @@ impl Canonical {
             c = c.subdivided();
         }
         Ok(c)
-    }
-
-    /// The subject's mesh: the shaped body, plus a skirt layer where `mode` and the views' masks
-    /// call for one (returned too, for reporting), plus `garments` as layers of their own, then
-    /// subdivided.
-    pub fn for_subject(
-        model: &BodyModel,
-        betas: &[f32],
-        subdivisions: usize,
-        views: &[View],
-        mode: SkirtMode,
-        garments: &[GarmentLayer],
-    ) -> Result<(Self, Option<SkirtLayer>), AvatarError> {
-        check_subdivisions(subdivisions)?;
-        let body = Self::from_body(model, betas, 0)?;
-        let layer = fit_skirt(&body, views, mode)?;
-        let mut c = match &layer {
-            Some(l) => body.with_layer(l)?,
-            None => body,
-        };
-        for garment in garments {
-            let gate = garment.offset_gate(&c.vertices);
-            c = c.with_garment(garment, &gate)?;
-        }
-        for _ in 0..subdivisions {
-            c = c.subdivided();
-        }
-        Ok((c, layer))
     }
 
     pub fn num_vertices(&self) -> usize {

@@ -2,7 +2,7 @@
 //! the views load, and its arrays as they load ([`crate::Trainer::resume`]), so an edited or
 //! corrupt file is refused naming the field instead of resuming into NaN.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use mannequin_io::Npz;
 
@@ -47,4 +47,9 @@ fn counter(npz: &Npz, key: &str, max: usize) -> Result<usize, AvatarError> {
         let reason = format!("expected an iteration from 0 to {max} (the run's --iters), found {value}");
         npz.field_error(key, reason).into()
     })
+}
+
+/// Where a model directory keeps its training checkpoint.
+pub fn checkpoint_path(dir: &Path) -> PathBuf {
+    dir.join("checkpoint.npz")
 }

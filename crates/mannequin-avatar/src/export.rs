@@ -8,9 +8,9 @@ use mannequin_mesh::gltf::{Skeleton, SkinnedLayer, SkinnedMesh};
 use mannequin_splat::{SplatScene, sh};
 
 use crate::avatar::{Avatar, Posed};
+use crate::canonical::BODY;
 use crate::config::Method;
 use crate::error::AvatarError;
-use crate::garment_layer::BODY;
 use crate::mesh_gaussians::GaussianGeometry;
 use crate::params::{host, host_rows};
 
@@ -389,7 +389,7 @@ mod tests {
             posedirs: Vec::new(),
             offset_gate: vec![1.0; 4],
             layer: vec![0; 4],
-            layer_names: vec![crate::garment_layer::BODY.into()],
+            layer_names: vec![crate::canonical::BODY.into()],
         }
     }
 

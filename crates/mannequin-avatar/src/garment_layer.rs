@@ -11,9 +11,6 @@ use mannequin_mesh::closest_point::ClosestPoint;
 use crate::canonical::Canonical;
 use crate::error::AvatarError;
 
-/// The name of layer 0, the body.
-pub const BODY: &str = "body";
-
 /// Cell size of the closest-point index over a garment (m): about the body's distance from it.
 const CELL: f32 = 0.03;
 
@@ -149,6 +146,7 @@ impl Canonical {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::canonical::BODY;
 
     /// An open cylinder of radius `r` around the y axis from y = 0 to 1, outward-facing.
     fn tube(r: f32, segments: usize, rings: usize) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {

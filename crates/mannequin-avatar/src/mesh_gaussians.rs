@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use burn::tensor::{Device, IndexingUpdateOp, Int, Tensor, TensorData};
 
-use crate::fused_binding::Topology;
+use crate::one_ring_mesh::OneRingMesh;
 
 /// In-plane scale factor of face Gaussians, β in Eq. 8.
 pub const FACE_SCALE: f64 = 0.5;
@@ -60,7 +60,7 @@ pub struct MeshIndex {
     /// [V, valence], 1 where `ring` is padding.
     pub ring_pad: Tensor<2>,
     pub valence: usize,
-    pub topology: Arc<Topology>,
+    pub mesh: Arc<OneRingMesh>,
 }
 
 impl MeshIndex {
@@ -70,12 +70,12 @@ impl MeshIndex {
             let idx: Vec<i64> = faces.iter().map(|f| f[k] as i64).collect();
             Tensor::<1, Int>::from_data(TensorData::new(idx, [faces.len()]), device)
         };
-        let topology = Topology::new(num_vertices, faces);
-        let valence = topology.valence();
+        let mesh = OneRingMesh::new(num_vertices, faces);
+        let valence = mesh.valence();
         let mut ring = Vec::with_capacity(num_vertices * valence);
         let mut pad = Vec::with_capacity(num_vertices * valence);
         for v in 0..num_vertices {
-            let r = topology.ring(v);
+            let r = mesh.ring(v);
             for k in 0..valence {
                 ring.push(r.get(k).map_or(v as i64, |&n| n as i64));
                 pad.push(if k < r.len() { 0.0f32 } else { 1.0 });
@@ -86,7 +86,7 @@ impl MeshIndex {
             ring: Tensor::from_data(TensorData::new(ring, [num_vertices * valence]), device),
             ring_pad: Tensor::from_data(TensorData::new(pad, [num_vertices, valence]), device),
             valence,
-            topology: Arc::new(topology),
+            mesh: Arc::new(mesh),
         }
     }
 }
@@ -161,7 +161,7 @@ pub fn face_gaussians(faces: &Faces) -> GaussianGeometry {
 /// cross products (each 2 A_f n_f), normalised.
 pub fn vertex_normals(faces: &Faces, index: &MeshIndex) -> Tensor<2> {
     let cross = &faces.cross;
-    let mut sum = Tensor::zeros([index.topology.num_vertices, 3], (&cross.device(), cross.dtype()));
+    let mut sum = Tensor::zeros([index.mesh.num_vertices, 3], (&cross.device(), cross.dtype()));
     for corner in &index.corners {
         sum = sum.select_assign(0, corner.clone(), cross.clone(), IndexingUpdateOp::Add);
     }
@@ -173,14 +173,14 @@ pub fn vertex_gaussians(vertices: &Tensor<2>, faces: &Faces, index: &MeshIndex) 
     let n = vertex_normals(faces, index);
     // Eq. 10: the reference axis is the coordinate axis least aligned with the normal; the
     // choice is piecewise constant, so it carries no gradient.
-    let axis = n.clone().detach().abs().argmin(1).reshape([index.topology.num_vertices]);
+    let axis = n.clone().detach().abs().argmin(1).reshape([index.mesh.num_vertices]);
     let r: Tensor<2> = axis.one_hot::<2>(3).float().cast(n.dtype());
     let t1 = normalise(r.cross(n.clone(), 1));
     let t2 = n.clone().cross(t1.clone(), 1);
     // Eq. 11: γ times the shortest one-ring edge. The nearest neighbour is found on detached
     // values (padding lifted out of the min), then that one edge is measured again with a plain
     // gather, so the gradient reaches exactly the two vertices of the shortest edge.
-    let v = index.topology.num_vertices;
+    let v = index.mesh.num_vertices;
     let neighbours = vertices.clone().detach().select(0, index.ring.clone()).reshape([v, index.valence, 3]);
     let offsets = neighbours - vertices.clone().detach().unsqueeze_dim::<3>(1);
     let lengths = offsets.square().sum_dim(2).reshape([v, index.valence]);

@@ -8,8 +8,8 @@ use serde::Serialize;
 
 use crate::config::AvatarConfig;
 use crate::error::AvatarError;
+use crate::options::TrainOptions;
 use crate::skirt_layer::SkirtMode;
-use crate::trainer::TrainOptions;
 
 /// What `mannequin train` was asked for, beyond the avatar and the loss settings: the body, the
 /// data and how they are read.

@@ -1,7 +1,7 @@
 //! Training (Tavatar §4.3, iHuman supplement §1.3): one view per iteration, the losses of
 //! Eq. 16 plus a mask term, Adam, checkpoints that resume bit for bit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use burn::tensor::{Gradients, Tensor, TensorData};
@@ -13,64 +13,10 @@ use crate::avatar::Avatar;
 use crate::checkpoint::Checkpoint;
 use crate::config::Method;
 use crate::error::AvatarError;
-use crate::losses::{MeshTopology, photometric_weighted};
+use crate::losses::{MeshRegularisers, photometric_weighted};
+use crate::options::TrainOptions;
 use crate::run::TrainingRun;
 use crate::views::View;
-
-/// Where Tavatar's learning rates end, as a fraction of their start. Constant rates leave the
-/// last iterations as noisy as the first: on synthetic subject 0 (2,000 iterations) decaying to
-/// 0.1 raised novel-view PSNR from 29.9 to 32.3 dB and lowered the normal error from 8.1° to
-/// 6.4° (3DGS decays its position rate likewise, to 0.01).
-pub const FINAL_LR_FACTOR: f64 = 0.1;
-
-/// Share of the iterations, from the start, trained on views at half resolution: their render
-/// and image losses cost a quarter as much (the per-Gaussian render work, offset field,
-/// optimiser and mesh terms do not shrink, so an iteration costs about three quarters of a
-/// full-resolution one on the synthetic dress), and the first iterations fit shape and mean
-/// colour, which half the pixels show as well.
-pub const HALF_RESOLUTION_SHARE: f64 = 0.5;
-
-/// Loss weights and switches.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct TrainOptions {
-    /// Named in a run's record as `train --iters` names it.
-    #[serde(rename = "iters")]
-    pub iterations: usize,
-    pub seed: u64,
-    /// λ_SSIM of Eqs. 12–13.
-    pub lambda_ssim: f64,
-    /// λ_n (Tavatar 0.05; iHuman 1).
-    pub lambda_normal: f64,
-    /// λ_m for Laplacian + normal consistency (0.01).
-    pub lambda_mesh: f64,
-    /// λ_t of the equilateral regulariser, Eq. 14 (0.01; 0 for the "w/o ER" ablation).
-    pub lambda_equilateral: f64,
-    /// Weight of the L1 between rendered alpha and the mask.
-    pub lambda_mask: f64,
-    /// Tavatar's learning rates decay exponentially to this fraction of their start by the last
-    /// iteration (1 keeps them constant).
-    pub final_lr_factor: f64,
-    /// Share of the iterations, from the start, on views at half resolution (0: none).
-    pub half_resolution_share: f64,
-}
-
-impl TrainOptions {
-    /// The seeds' weights for `method`.
-    pub fn new(method: Method, iterations: usize, seed: u64) -> Self {
-        let ihuman = method == Method::Ihuman;
-        Self {
-            iterations,
-            seed,
-            lambda_ssim: 0.2,
-            lambda_normal: if ihuman { 1.0 } else { 0.05 },
-            lambda_mesh: 0.01,
-            lambda_equilateral: if ihuman { 0.0 } else { 0.01 },
-            lambda_mask: 0.1,
-            final_lr_factor: FINAL_LR_FACTOR,
-            half_resolution_share: HALF_RESOLUTION_SHARE,
-        }
-    }
-}
 
 /// Wall time of each phase of one iteration, for the benchmark's breakdown.
 #[derive(Debug, Clone, Default)]
@@ -101,7 +47,7 @@ pub struct Trainer {
     views: Vec<View>,
     /// `views` at half resolution, for the first iterations (see `half_resolution_share`).
     halved: Vec<View>,
-    topology: MeshTopology,
+    regularisers: MeshRegularisers,
     /// 1 / (mean canonical edge length)²: makes the Laplacian term unit-free, so λ_m weighs it
     /// like the (unit-free) normal consistency whatever the mesh resolution.
     laplacian_scale: f64,
@@ -149,8 +95,8 @@ impl Trainer {
         if views.is_empty() {
             return Err(AvatarError::Invalid("no training views".into()));
         }
-        let topology =
-            MeshTopology::new(avatar.canonical.num_vertices(), &avatar.canonical.faces, avatar.device())?;
+        let regularisers =
+            MeshRegularisers::new(avatar.canonical.num_vertices(), &avatar.canonical.faces, avatar.device())?;
         let mut avatar = avatar;
         let colours = crate::colour_init::observed_colours(&avatar, &views)?;
         avatar.set_sh_dc(crate::colour_init::dc_coefficients(&colours))?;
@@ -169,7 +115,7 @@ impl Trainer {
             adam,
             views,
             halved,
-            topology,
+            regularisers,
             laplacian_scale,
             base_lr,
             profile: false,
@@ -292,11 +238,11 @@ impl Trainer {
             Tensor::from_data(TensorData::new(view.mask.clone(), [crop.height, crop.width]), &device);
         loss = loss + (alpha - mask).abs().mean() * o.lambda_mask;
         // Laplacian smoothness of the offset field and normal consistency of V_s (Eq. 15).
-        let mesh = self.topology.laplacian(offsets)? * self.laplacian_scale
-            + self.topology.normal_consistency(personalised.clone())?;
+        let mesh = self.regularisers.laplacian(offsets)? * self.laplacian_scale
+            + self.regularisers.normal_consistency(personalised.clone())?;
         loss = loss + mesh * o.lambda_mesh;
         if o.lambda_equilateral > 0.0 {
-            loss = loss + self.topology.equilateral(personalised)? * o.lambda_equilateral;
+            loss = loss + self.regularisers.equilateral(personalised)? * o.lambda_equilateral;
         }
         let value = loss.clone().into_scalar::<f64>();
         t.losses = self.lap(clock)?;
@@ -364,9 +310,4 @@ impl Trainer {
         self.iteration = checkpoint.iteration;
         Ok(())
     }
-}
-
-/// Where a model directory keeps its training checkpoint.
-pub fn checkpoint_path(dir: &Path) -> PathBuf {
-    dir.join("checkpoint.npz")
 }

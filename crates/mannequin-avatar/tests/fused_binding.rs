@@ -73,7 +73,7 @@ fn fused_binding_matches_the_tensor_composition_and_its_autodiff() {
     let mut rng = SplitMix64::new(5);
     for (with_faces, with_vertices) in [(true, true), (true, false), (false, true)] {
         let config = BindConfig {
-            topology: index.topology.clone(),
+            mesh: index.mesh.clone(),
             face_gaussians: with_faces,
             vertex_gaussians: with_vertices,
         };

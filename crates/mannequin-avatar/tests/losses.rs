@@ -7,8 +7,8 @@
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::AvatarError;
 use mannequin_avatar::losses::{
-    MeshTopology, gaussian_blur_valid, gaussian_window, photometric, photometric_weighted, ssim, ssim_map,
-    ssim_with_blur,
+    MeshRegularisers, gaussian_blur_valid, gaussian_window, photometric, photometric_weighted, ssim,
+    ssim_map, ssim_with_blur,
 };
 use mannequin_data::Image;
 use mannequin_data::metrics::ssim::ssim as metric_ssim;
@@ -292,8 +292,8 @@ fn ssim_on_wgpu_matches_flex() {
 
 // ---- Mesh regularisers ----
 
-fn topology(num_vertices: usize, faces: &[[u32; 3]]) -> MeshTopology {
-    MeshTopology::new(num_vertices, faces, &Device::flex()).unwrap()
+fn topology(num_vertices: usize, faces: &[[u32; 3]]) -> MeshRegularisers {
+    MeshRegularisers::new(num_vertices, faces, &Device::flex()).unwrap()
 }
 
 fn vertices(v: &[[f64; 3]]) -> Tensor<2> {
@@ -408,7 +408,7 @@ fn mesh_regulariser_gradients_match_finite_differences() {
     let (v, f) = flat_grid(3);
     let mut rng = SplitMix64::new(21);
     let x: Vec<f64> = v.iter().flatten().map(|&c| c + 0.3 * rng.normal()).collect();
-    let topo = MeshTopology::new(v.len(), &f, &Device::flex()).unwrap();
+    let topo = MeshRegularisers::new(v.len(), &f, &Device::flex()).unwrap();
     let shape = [v.len(), 3];
     check_gradient("d laplacian", &x, shape, |v| topo.laplacian(v).unwrap());
     check_gradient("d normal consistency", &x, shape, |v| topo.normal_consistency(v).unwrap());
@@ -418,10 +418,10 @@ fn mesh_regulariser_gradients_match_finite_differences() {
 #[test]
 fn mesh_topology_rejects_bad_faces_and_vertices() {
     let device = Device::flex();
-    let message = |r: Result<MeshTopology, AvatarError>| r.expect_err("an error").to_string();
-    assert!(message(MeshTopology::new(3, &[[0, 1, 3]], &device)).contains("names vertex 3"));
-    assert!(message(MeshTopology::new(3, &[[0, 1, 1]], &device)).contains("repeats a vertex"));
-    assert!(message(MeshTopology::new(3, &[], &device)).contains("at least one face"));
+    let message = |r: Result<MeshRegularisers, AvatarError>| r.expect_err("an error").to_string();
+    assert!(message(MeshRegularisers::new(3, &[[0, 1, 3]], &device)).contains("names vertex 3"));
+    assert!(message(MeshRegularisers::new(3, &[[0, 1, 1]], &device)).contains("repeats a vertex"));
+    assert!(message(MeshRegularisers::new(3, &[], &device)).contains("at least one face"));
     let topo = topology(3, &[[0, 1, 2]]);
     let wrong = Tensor::<2>::zeros([4, 3], &device);
     for r in [topo.laplacian(wrong.clone()), topo.normal_consistency(wrong.clone()), topo.equilateral(wrong)]
@@ -446,7 +446,7 @@ fn default_body_topology_is_a_closed_manifold_mesh() {
 fn fused_mesh_regularisers_match_their_tensor_compositions() {
     let body = mannequin_body::BodyModel::default_body();
     let device = Device::flex().autodiff();
-    let topo = MeshTopology::new(body.num_vertices(), &body.faces, &device).unwrap();
+    let topo = MeshRegularisers::new(body.num_vertices(), &body.faces, &device).unwrap();
     let mut rng = SplitMix64::new(8);
     // Rounded to f32, so the f32 and f64 runs see the same mesh.
     let x: Vec<f64> = body

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
 use mannequin_avatar::canonical::MAX_SUBDIVISIONS;
-use mannequin_avatar::trainer::checkpoint_path;
+use mannequin_avatar::checkpoint_path;
 use mannequin_avatar::{
     Avatar, AvatarConfig, AvatarError, Canonical, Checkpoint, GarmentRecord, Method, SkirtMode, TrainOptions,
     Trainer, TrainingRun, load_views,

@@ -25,6 +25,6 @@ impl BindingBackend for Flex {
         let (v, g) = (contiguous(vertices), contiguous(grad));
         let d =
             host::backward(v.as_slice::<f32>().expect(LAYOUT), g.as_slice::<f32>().expect(LAYOUT), &config);
-        FlexTensor::from_data(TensorData::new(d, [config.topology.num_vertices, 3]))
+        FlexTensor::from_data(TensorData::new(d, [config.mesh.num_vertices, 3]))
     }
 }

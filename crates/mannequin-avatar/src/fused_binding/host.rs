@@ -7,8 +7,9 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::{BindConfig, PACKED, PLANES, Topology, plane_starts};
+use super::{BindConfig, PACKED, PLANES, plane_starts};
 use crate::mesh_gaussians::{FACE_SCALE, NORM_EPS, NORMAL_SCALE, VERTEX_SCALE};
+use crate::one_ring_mesh::OneRingMesh;
 
 type V3 = [f32; 3];
 
@@ -188,9 +189,9 @@ impl Face {
 
 /// Sum of the adjacent faces' cross products per vertex (Eq. 9 before normalising), summed in
 /// face order.
-fn cross_sums(topology: &Topology, faces: &[Face]) -> Vec<V3> {
-    let mut sums = vec![[0.0; 3]; topology.num_vertices];
-    for (f, face) in topology.faces.iter().zip(faces) {
+fn cross_sums(mesh: &OneRingMesh, faces: &[Face]) -> Vec<V3> {
+    let mut sums = vec![[0.0; 3]; mesh.num_vertices];
+    for (f, face) in mesh.faces.iter().zip(faces) {
         for &i in f {
             sums[i as usize] = add(sums[i as usize], face.cross);
         }
@@ -213,7 +214,7 @@ struct Vertex {
 }
 
 impl Vertex {
-    fn new(v: &[f32], topology: &Topology, sums: &[V3], i: usize) -> Self {
+    fn new(v: &[f32], mesh: &OneRingMesh, sums: &[V3], i: usize) -> Self {
         let position = point(v, i as u32);
         let sum = sums[i];
         let sum_norm = norm(sum);
@@ -228,7 +229,7 @@ impl Vertex {
             let d = sub(point(v, j), position);
             dot(d, d)
         };
-        let ring = topology.ring(i).iter().copied();
+        let ring = mesh.ring(i).iter().copied();
         let nearest = ring.min_by(|&a, &b| squared(a).total_cmp(&squared(b))).unwrap_or(i as u32);
         let edge = sub(point(v, nearest), position);
         Self { position, sum, sum_norm, axis, u, u_norm: norm(u), nearest, edge, edge_length: norm(edge) }
@@ -261,18 +262,18 @@ impl Vertex {
     }
 }
 
-fn faces_of(v: &[f32], topology: &Topology) -> Vec<Face> {
-    topology.faces.par_iter().map(|&f| Face::new(v, f)).collect()
+fn faces_of(v: &[f32], mesh: &OneRingMesh) -> Vec<Face> {
+    mesh.faces.par_iter().map(|&f| Face::new(v, f)).collect()
 }
 
-fn vertices_of(v: &[f32], topology: &Topology, sums: &[V3]) -> Vec<Vertex> {
-    (0..topology.num_vertices).into_par_iter().map(|i| Vertex::new(v, topology, sums, i)).collect()
+fn vertices_of(v: &[f32], mesh: &OneRingMesh, sums: &[V3]) -> Vec<Vertex> {
+    (0..mesh.num_vertices).into_par_iter().map(|i| Vertex::new(v, mesh, sums, i)).collect()
 }
 
 /// Gaussians `[G · PACKED]` of vertices `[V · 3]` as [`PLANES`]: face Gaussians first, then
 /// vertex ones.
 pub(crate) fn forward(v: &[f32], config: &BindConfig) -> Vec<f32> {
-    let t = &config.topology;
+    let t = &config.mesh;
     let faces = faces_of(v, t);
     let g = config.num_gaussians();
     let mut out = vec![0.0; PACKED * g];
@@ -287,7 +288,7 @@ pub(crate) fn forward(v: &[f32], config: &BindConfig) -> Vec<f32> {
 
 /// The gradient `[V · 3]` of the vertices given the gradient `grad` of [`forward`]'s output.
 pub(crate) fn backward(v: &[f32], grad: &[f32], config: &BindConfig) -> Vec<f32> {
-    let t = &config.topology;
+    let t = &config.mesh;
     let faces = faces_of(v, t);
     let g = config.num_gaussians();
     let mut d = vec![0.0f32; 3 * t.num_vertices];

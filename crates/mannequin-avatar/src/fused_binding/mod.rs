@@ -12,9 +12,9 @@ use std::sync::Arc;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
 use burn::tensor::Tensor;
-use mannequin_mesh::adjacency::one_rings;
 
 use crate::mesh_gaussians::GaussianGeometry;
+use crate::one_ring_mesh::OneRingMesh;
 
 /// The op's output is four planes, one after the other, each `[G, width]` row-major: means (3),
 /// frames (9, row-major with columns t1, t2, n), scales (3) and normals (3, the frame's third
@@ -36,51 +36,18 @@ pub(crate) fn plane_starts(g: usize) -> [usize; 4] {
     })
 }
 
-/// A fixed mesh's faces and one-rings (each ring sorted, as `MeshIndex` pads them).
-#[derive(Debug)]
-pub struct Topology {
-    pub num_vertices: usize,
-    pub faces: Vec<[u32; 3]>,
-    ring_start: Vec<usize>,
-    rings: Vec<u32>,
-}
-
-impl Topology {
-    /// Faces must already be validated against `num_vertices`.
-    pub fn new(num_vertices: usize, faces: &[[u32; 3]]) -> Self {
-        let rings = one_rings(num_vertices, faces);
-        let ring_start = std::iter::once(0)
-            .chain(rings.iter().scan(0, |end, r| {
-                *end += r.len();
-                Some(*end)
-            }))
-            .collect();
-        Self { num_vertices, faces: faces.to_vec(), ring_start, rings: rings.concat() }
-    }
-
-    /// Vertex `i`'s neighbours, ascending.
-    pub fn ring(&self, i: usize) -> &[u32] {
-        &self.rings[self.ring_start[i]..self.ring_start[i + 1]]
-    }
-
-    /// The largest valence (at least 1).
-    pub fn valence(&self) -> usize {
-        (0..self.num_vertices).map(|i| self.ring(i).len()).max().unwrap_or(0).max(1)
-    }
-}
-
 /// Which Gaussians the op makes, on which mesh.
 #[derive(Clone, Debug)]
 pub struct BindConfig {
-    pub topology: Arc<Topology>,
+    pub mesh: Arc<OneRingMesh>,
     pub face_gaussians: bool,
     pub vertex_gaussians: bool,
 }
 
 impl BindConfig {
     pub fn num_gaussians(&self) -> usize {
-        usize::from(self.face_gaussians) * self.topology.faces.len()
-            + usize::from(self.vertex_gaussians) * self.topology.num_vertices
+        usize::from(self.face_gaussians) * self.mesh.faces.len()
+            + usize::from(self.vertex_gaussians) * self.mesh.num_vertices
     }
 }
 

@@ -15,15 +15,15 @@
 use burn::tensor::Tensor;
 use glam::DVec3;
 
-use super::mesh_loss::{HostMesh, MeshTerm, add, sum_over_elements, vertex};
+use super::mesh_loss::{HostMesh, add, sum_over_elements, vertex};
+use super::regularisers::MeshRegularisers;
 use super::rows::{EPS, dot, length};
-use super::topology::MeshTopology;
 use crate::AvatarError;
 
-impl MeshTopology {
+impl MeshRegularisers {
     /// `mean_f [Var(‖e₁‖, ‖e₂‖, ‖e₃‖) + Σ_φ (1 − cos φ)²]` over faces, as `[1]`.
     pub fn equilateral(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
-        self.fused_or(MeshTerm::Equilateral, vertices, |v| self.equilateral_tensors(v))
+        self.fused_or(equilateral_host, vertices, |v| self.equilateral_tensors(v))
     }
 
     /// [`Self::equilateral`] composed from tensor ops.
@@ -55,10 +55,10 @@ impl MeshTopology {
 /// The loss on the host. Gradients are gathered per edge: `g_l` for each length and `g_E` for
 /// each edge vector directly (through the dot products of the cosines), then `∂l/∂E = E/l`.
 /// The variance's mean drops out of its gradient (`Σ (l − m) = 0`).
-pub(super) fn equilateral_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
-    let faces = &mesh.topology.faces;
+fn equilateral_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+    let faces = &mesh.rings.faces;
     let weight = 1.0 / faces.len() as f64;
-    let total = sum_over_elements(faces.len(), mesh.topology.num_vertices, grad, |f, grad| {
+    let total = sum_over_elements(faces.len(), mesh.rings.num_vertices, grad, |f, grad| {
         let corners = faces[f];
         let p = corners.map(|i| vertex(v, i));
         let edges = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];

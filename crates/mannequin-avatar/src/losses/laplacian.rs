@@ -6,11 +6,11 @@ use burn::tensor::{IndexingUpdateOp, Tensor};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::mesh_loss::{HostMesh, MeshTerm, vertex};
-use super::topology::MeshTopology;
+use super::mesh_loss::{HostMesh, vertex};
+use super::regularisers::MeshRegularisers;
 use crate::AvatarError;
 
-impl MeshTopology {
+impl MeshRegularisers {
     /// `δ_i = v_i − (1/|N(i)|) Σ_{j∈N(i)} v_j` per vertex, `[V, 3]`; 0 for isolated vertices.
     pub fn laplacian_vectors(&self, vertices: Tensor<2>) -> Result<Tensor<2>, AvatarError> {
         self.check(&vertices)?;
@@ -27,7 +27,7 @@ impl MeshTopology {
     /// `mean_i ‖δ_i‖²` over the vertices that have neighbours, as `[1]`. The squared norm (not
     /// PyTorch3D's plain norm) keeps the loss smooth where δ = 0.
     pub fn laplacian(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
-        self.fused_or(MeshTerm::Laplacian, vertices, |v| self.laplacian_tensors(v))
+        self.fused_or(laplacian_host, vertices, |v| self.laplacian_tensors(v))
     }
 
     /// [`Self::laplacian`] composed from tensor ops.
@@ -39,7 +39,7 @@ impl MeshTopology {
 
 /// δ_i of every vertex, from the one-rings.
 fn deltas(mesh: &HostMesh, v: &[f64]) -> Vec<DVec3> {
-    let t = &mesh.topology;
+    let t = &mesh.rings;
     (0..t.num_vertices as u32)
         .into_par_iter()
         .map(|i| {
@@ -54,11 +54,11 @@ fn deltas(mesh: &HostMesh, v: &[f64]) -> Vec<DVec3> {
 
 /// The loss on the host, with `∂L/∂v_k = (2/N)(δ_k − Σ_{i∈N(k)} δ_i/|N(i)|)` (rings are
 /// symmetric, so each vertex gathers from its own ring).
-pub(super) fn laplacian_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+fn laplacian_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
     let delta = deltas(mesh, v);
     let scale = 1.0 / mesh.num_connected as f64;
     if let Some(grad) = grad {
-        let t = &mesh.topology;
+        let t = &mesh.rings;
         grad.par_chunks_mut(3).enumerate().for_each(|(k, g)| {
             let pulled: DVec3 =
                 t.ring(k).iter().map(|&i| delta[i as usize] / t.ring(i as usize).len() as f64).sum();

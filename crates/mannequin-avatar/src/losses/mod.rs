@@ -8,11 +8,11 @@ mod laplacian;
 pub mod mesh_loss;
 mod normal_consistency;
 mod photometric;
+mod regularisers;
 mod rows;
 mod ssim;
-mod topology;
 
 pub use blur::{BlurBackend, gaussian_blur_valid, gaussian_window};
 pub use photometric::{LAMBDA_SSIM, photometric, photometric_weighted};
+pub use regularisers::MeshRegularisers;
 pub use ssim::{SsimBackend, ssim, ssim_map, ssim_with_blur};
-pub use topology::MeshTopology;

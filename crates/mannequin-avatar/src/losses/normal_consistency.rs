@@ -10,16 +10,16 @@
 
 use burn::tensor::Tensor;
 
-use super::mesh_loss::{HostMesh, MeshTerm, add, sum_over_elements, vertex};
+use super::mesh_loss::{HostMesh, add, sum_over_elements, vertex};
+use super::regularisers::MeshRegularisers;
 use super::rows::{EPS, dot, length};
-use super::topology::MeshTopology;
 use crate::AvatarError;
 
-impl MeshTopology {
+impl MeshRegularisers {
     /// Mean over face pairs sharing an edge of `1 − cos(n₁, n₂)`, as `[1]`; 0 when no edge is
     /// shared.
     pub fn normal_consistency(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
-        self.fused_or(MeshTerm::NormalConsistency, vertices, |v| self.normal_consistency_tensors(v))
+        self.fused_or(normal_consistency_host, vertices, |v| self.normal_consistency_tensors(v))
     }
 
     /// [`Self::normal_consistency`] composed from tensor ops.
@@ -43,7 +43,7 @@ impl MeshTopology {
 /// The loss on the host. Here the normals are formed (`n₁ = e × u`, `n₂ = w × e`, in f64), and
 /// `∂cos/∂n₁ = n₂/(|n₁||n₂|) − cos·n₁/|n₁|²` (likewise for `n₂`) is taken back through the cross
 /// products: `∂(n₁·g)/∂e = u × g`, `∂(n₁·g)/∂u = g × e`, `∂(n₂·g)/∂w = e × g`, `∂(n₂·g)/∂e = g × w`.
-pub(super) fn normal_consistency_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+fn normal_consistency_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
     let h = mesh.hinges.len();
     if h == 0 {
         if let Some(g) = grad {
@@ -52,7 +52,7 @@ pub(super) fn normal_consistency_host(mesh: &HostMesh, v: &[f64], grad: Option<&
         return 0.0;
     }
     let weight = -1.0 / h as f64;
-    let cosines = sum_over_elements(h, mesh.topology.num_vertices, grad, |k, grad| {
+    let cosines = sum_over_elements(h, mesh.rings.num_vertices, grad, |k, grad| {
         let [a, b, c, d] = mesh.hinges[k];
         let p = vertex(v, a);
         let (e, u, w) = (vertex(v, b) - p, vertex(v, c) - p, vertex(v, d) - p);

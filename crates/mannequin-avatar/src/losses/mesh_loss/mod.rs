@@ -14,31 +14,27 @@ use burn::backend::{Backend, Dispatch, backend_extension};
 use burn::tensor::Tensor;
 use rayon::prelude::*;
 
-use crate::fused_binding::Topology;
+use crate::one_ring_mesh::OneRingMesh;
 
 /// The fixed mesh the host terms read.
 #[derive(Debug)]
 pub struct HostMesh {
     /// Faces and sorted one-rings.
-    pub topology: Arc<Topology>,
+    pub rings: Arc<OneRingMesh>,
     /// `[a, b, c, d]` per pair of faces sharing the edge `(a, b)`, `c` and `d` opposite it.
     pub hinges: Vec<[u32; 4]>,
     /// Vertices with at least one neighbour.
     pub num_connected: usize,
 }
 
-/// Which regulariser the op evaluates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MeshTerm {
-    Laplacian,
-    NormalConsistency,
-    Equilateral,
-}
+/// A regulariser on the host: its loss at vertices `v` (`[V·3]`, f64), and its gradient when
+/// `grad` is given (overwritten).
+pub type HostTerm = fn(&HostMesh, &[f64], Option<&mut [f64]>) -> f64;
 
 /// One regulariser on one mesh.
 #[derive(Clone, Debug)]
 pub struct MeshLoss {
-    pub term: MeshTerm,
+    pub term: HostTerm,
     pub mesh: Arc<HostMesh>,
 }
 
@@ -46,12 +42,7 @@ impl MeshLoss {
     /// The loss at vertices `v` (`[V·3]`, f64), and its gradient when `grad` is given
     /// (overwritten).
     pub fn evaluate(&self, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
-        let mesh = &self.mesh;
-        match self.term {
-            MeshTerm::Laplacian => super::laplacian::laplacian_host(mesh, v, grad),
-            MeshTerm::NormalConsistency => super::normal_consistency::normal_consistency_host(mesh, v, grad),
-            MeshTerm::Equilateral => super::equilateral::equilateral_host(mesh, v, grad),
-        }
+        (self.term)(&self.mesh, v, grad)
     }
 }
 

@@ -1,17 +1,20 @@
-//! The fixed connectivity the mesh regularisers read, built once from the faces: the index
-//! tensors their gathers and scatters use, so each loss evaluation is a handful of tensor ops.
+//! The mesh regularisers of one fixed mesh, built once from its faces: the index tensors their
+//! gathers and scatters use (edges, one-rings, face pairs), so each loss evaluation is a handful
+//! of tensor ops, and the same mesh on the host for the fused op. The terms themselves live in
+//! their own files ([`super::laplacian`], [`super::normal_consistency`], [`super::equilateral`]).
 
 use std::sync::Arc;
 
 use burn::tensor::{Device, Int, Tensor, TensorData};
 
-use super::mesh_loss::{HostMesh, MeshLoss, MeshTerm, mesh_loss};
+use super::mesh_loss::{HostMesh, HostTerm, MeshLoss, mesh_loss};
 use crate::AvatarError;
-use crate::fused_binding::Topology;
+use crate::one_ring_mesh::OneRingMesh;
 
-/// Edges, one-rings and face pairs of a triangle mesh, as index tensors on one device.
+/// The regularisers of a triangle mesh: its edges, one-rings and face pairs as index tensors
+/// on one device.
 #[derive(Debug, Clone)]
-pub struct MeshTopology {
+pub struct MeshRegularisers {
     pub(super) num_vertices: usize,
     pub(super) device: Device,
     /// Corner `k` of every face, `[F]` for k = 0, 1, 2.
@@ -39,7 +42,7 @@ fn indices(v: Vec<i64>, device: &Device) -> Tensor<1, Int> {
     Tensor::from_data(TensorData::new(v, [n]), device)
 }
 
-impl MeshTopology {
+impl MeshRegularisers {
     /// Connectivity of `faces` over `num_vertices` vertices, with tensors on `device`. Faces must
     /// name three distinct vertices below `num_vertices`.
     pub fn new(num_vertices: usize, faces: &[[u32; 3]], device: &Device) -> Result<Self, AvatarError> {
@@ -86,7 +89,7 @@ impl MeshTopology {
         let (num_edges, num_hinges) = (from.len() / 2, hinge[0].len());
         let num_connected = degree.iter().filter(|&&d| d > 0).count();
         let host = Arc::new(HostMesh {
-            topology: Arc::new(Topology::new(num_vertices, faces)),
+            rings: Arc::new(OneRingMesh::new(num_vertices, faces)),
             hinges: (0..num_hinges).map(|k| hinge.each_ref().map(|h| h[k] as u32)).collect(),
             num_connected,
         });
@@ -146,7 +149,7 @@ impl MeshTopology {
     /// The term by the fused host op where the device runs it, else by `tensors`.
     pub(super) fn fused_or(
         &self,
-        term: MeshTerm,
+        term: HostTerm,
         vertices: Tensor<2>,
         tensors: impl FnOnce(Tensor<2>) -> Result<Tensor<1>, AvatarError>,
     ) -> Result<Tensor<1>, AvatarError> {
