@@ -5,10 +5,13 @@
 pub mod category;
 mod collider;
 mod drape;
+mod dress_error;
 pub mod ease;
 mod error;
 pub mod file;
 mod garment;
+mod garment_cache;
+mod layered_scene;
 mod layering;
 mod make;
 pub mod ngd;
@@ -20,8 +23,11 @@ mod wear;
 
 pub use category::{CATEGORY_NAMES, Category};
 pub use ease::{Ease, SIZE_NAMES};
+pub use dress_error::DressError;
 pub use error::GarmentError;
 pub use garment::{Garment, Recipe};
+pub use garment_cache::load_or_make;
+pub use layered_scene::write_layered_scene;
 pub use make::{TEMPLATE_REVISION, make_garment};
 pub use transfer::Dressed;
 pub use wear::{LayerProgress, WearProgress, WearStep, Wearer, WornLayer, wear};

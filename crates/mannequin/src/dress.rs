@@ -6,17 +6,16 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args as ClapArgs;
-use mannequin_body::{BodyModel, Settling, shape_body, skeletal_animation, skinned_body};
+use mannequin_body::{BodyModel, Settling, shape_body};
 use mannequin_cloth::{Material, Settings, quality};
-use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{
-    Category, Dressed, Ease, Garment, LayerProgress, SIZE_NAMES, TEMPLATE_REVISION, WearProgress, WearStep,
-    Wearer, make_garment, wear,
+    Dressed, Garment, LayerProgress, SIZE_NAMES, WearProgress, WearStep, Wearer, load_or_make, wear,
+    write_layered_scene,
 };
 use mannequin_io::{Npz, NpzWriter};
-use mannequin_mesh::{MorphSequence, PointCache, write_scene_glb};
+use mannequin_mesh::MorphSequence;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -126,7 +125,7 @@ pub fn run(args: Args) -> Result<()> {
     let loaded: Vec<(String, Garment)> = args
         .garments
         .iter()
-        .map(|g| load_or_make(g, &model, &args.body.body, &args.size))
+        .map(|g| Ok(load_or_make(g, &model, &args.body.body, &args.size)?))
         .collect::<Result<_>>()?;
     let settle = Settling::settle_frames(args.settle, motion.fps)?;
     let vertices = model.num_vertices() + loaded.iter().map(|(_, g)| g.vertex_count()).sum::<usize>();
@@ -411,64 +410,6 @@ fn read_checkpoint(
     Ok(progress)
 }
 
-/// A `.garment` file, or a category name made at `size` on this body and cached under
-/// `$XDG_CACHE_HOME/mannequin/garments` (or `~/.cache/...`), keyed by everything that made it.
-pub(crate) fn load_or_make(
-    spec: &str,
-    model: &BodyModel,
-    body: &str,
-    size: &str,
-) -> Result<(String, Garment)> {
-    let Ok(category) = Category::named(spec) else {
-        let path = Path::new(spec);
-        if !path.exists() {
-            bail!(
-                "--garments: {spec:?} is neither a .garment file nor a category ({})",
-                mannequin_garment::CATEGORY_NAMES.join(", ")
-            );
-        }
-        let garment = read_garment(path)?;
-        garment.check_body(model).with_context(|| path.display().to_string())?;
-        let name = path.file_stem().map_or_else(|| "garment".into(), |s| s.to_string_lossy().into_owned());
-        return Ok((name, garment));
-    };
-    let body_key = if Path::new(body).exists() {
-        mannequin_data::fingerprint::hash_bytes(
-            &std::fs::read(body).with_context(|| format!("reading {body}"))?,
-        )
-    } else {
-        body.to_string()
-    };
-    let key =
-        format!("{}-{size}-{body_key}-v{}-r{TEMPLATE_REVISION}", category.name(), env!("CARGO_PKG_VERSION"));
-    let cache = cache_dir().map(|d| d.join("garments").join(format!("{key}.garment")));
-    if let Some(path) = &cache
-        && path.exists()
-        && let Ok(garment) = read_garment(path)
-    {
-        tracing::info!("{}: from the cache, {}", category.name(), path.display());
-        return Ok((category.name().to_string(), garment));
-    }
-    let start = Instant::now();
-    let garment =
-        make_garment(category, Ease::size(size)?, 0.015, category.default_material(), model, body, &[])?;
-    tracing::info!("{}: made in {:.1} s", category.name(), start.elapsed().as_secs_f64());
-    if let Some(path) = &cache {
-        let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(anyhow::Error::from);
-        if let Err(e) = written.and_then(|()| Ok(write_garment(path, &garment)?)) {
-            tracing::warn!("not cached: {}: {e:#}", path.display());
-        }
-    }
-    Ok((category.name().to_string(), garment))
-}
-
-fn cache_dir() -> Option<PathBuf> {
-    std::env::var_os("XDG_CACHE_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
-        .map(|d| d.join("mannequin"))
-}
-
 /// dressed.glb (the skinned body playing the motion, each garment as morph targets in sync)
 /// and one Blender point cache per garment.
 fn write_scene(
@@ -493,27 +434,7 @@ fn write_scene(
     let poses = motion.poses_for(model)?;
     let pl = model.pose_len();
     let motion = (&poses[..f * pl], &motion.trans[..3 * f], motion.fps);
-    write_layered_scene(&dir.join("dressed.glb"), model, betas, motion, &morphs)
-}
-
-/// `glb`: the skinned body of shape `betas` playing `(poses, trans, fps)` (SMPL's layout), with
-/// each layer's frames as morph targets in sync; and beside it each layer's frames as a Blender
-/// point cache, `<name>.pc2`.
-pub(crate) fn write_layered_scene(
-    glb: &Path,
-    model: &BodyModel,
-    betas: &[f32],
-    (poses, trans, fps): (&[f32], &[f32], f32),
-    layers: &[MorphSequence],
-) -> Result<()> {
-    let dir = glb.parent().unwrap_or(Path::new("."));
-    for layer in layers {
-        PointCache { start: 0.0, sampling: 1.0, frames: layer.frames.clone() }
-            .write(&dir.join(format!("{}.pc2", layer.name)))?;
-    }
-    let animation = skeletal_animation(model.num_joints(), poses, trans, fps)?;
-    write_scene_glb(glb, &skinned_body(model, betas)?, Some(&animation), layers)?;
-    Ok(())
+    Ok(write_layered_scene(&dir.join("dressed.glb"), model, betas, motion, &morphs)?)
 }
 
 fn write_metrics(

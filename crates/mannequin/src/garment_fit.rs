@@ -19,7 +19,7 @@ use mannequin_garment::{Category, Dressed};
 use mannequin_mesh::{MorphSequence, TriMesh};
 
 use crate::body::load_body;
-use crate::dress::{load_or_make, write_layered_scene};
+use mannequin_garment::{load_or_make, write_layered_scene};
 use mannequin_io::progress::{JobTimer, bar};
 
 /// Below this mean mask IoU over the first pass through the frames, the category is probably not
@@ -292,13 +292,13 @@ fn write_scene(
     let layer = MorphSequence { name: category.to_string(), mesh, frames: posed, fps: SCENE_FPS };
     let poses: Vec<f32> = frames.iter().flat_map(|f| f.pose.pose.clone()).collect();
     let trans: Vec<f32> = frames.iter().flat_map(|f| f.pose.transl).collect();
-    write_layered_scene(
+    Ok(write_layered_scene(
         &dir.join("fitted.glb"),
         model,
         &train.poses.betas,
         (&poses, &trans, SCENE_FPS),
         &[layer],
-    )
+    )?)
 }
 
 fn mean(v: &[f64]) -> f64 {

@@ -1,0 +1,41 @@
+//! Dressing errors: what goes wrong loading garments, simulating them on a body, checkpointing
+//! and writing the scene, one line each with the file or field at fault.
+
+use mannequin_body::BodyError;
+use mannequin_cloth::ClothError;
+use mannequin_io::IoError;
+use mannequin_mesh::MeshFileError;
+
+use crate::error::GarmentError;
+
+#[derive(Debug, thiserror::Error)]
+pub enum DressError {
+    #[error("{field}: {reason}")]
+    Invalid { field: String, reason: String },
+    #[error("reading {path}: {reason}")]
+    Read { path: String, reason: String },
+    /// `inner` said of `context` (a file, a garment): one line, as `anyhow`'s context reads.
+    #[error("{context}: {inner}")]
+    In { context: String, inner: Box<DressError> },
+    #[error(transparent)]
+    Garment(#[from] GarmentError),
+    #[error(transparent)]
+    Cloth(#[from] ClothError),
+    #[error(transparent)]
+    Body(#[from] BodyError),
+    #[error(transparent)]
+    MeshFile(#[from] MeshFileError),
+    #[error(transparent)]
+    Io(#[from] IoError),
+}
+
+impl DressError {
+    pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        Self::Invalid { field: field.into(), reason: reason.into() }
+    }
+
+    /// This error said of `context`.
+    pub(crate) fn of(self, context: impl Into<String>) -> Self {
+        Self::In { context: context.into(), inner: Box::new(self) }
+    }
+}
