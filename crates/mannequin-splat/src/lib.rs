@@ -29,10 +29,12 @@
 //! ```
 
 mod camera;
+pub mod camera_file;
 pub mod camera_json;
 mod composite;
 mod composite_vjp;
 mod error;
+pub mod framing;
 mod gaussians;
 mod gpu;
 mod op;
@@ -45,8 +47,10 @@ pub mod sh;
 mod tiles;
 
 pub use camera::Camera;
+pub use camera_file::read_camera;
 pub use camera_json::parse_camera_json;
 pub use error::SplatError;
+pub use framing::{box_centre, clip_camera, front_camera};
 pub use gaussians::{Colors, GaussianGrads, Gaussians, Rotations};
 pub use gpu::{GpuUnavailable, gpu_device};
 pub use op::{ColorTensor, RotationTensor, SplatBackend, SplatConfig, SplatImages, splat_render};
