@@ -11,7 +11,11 @@ impl Motion {
     /// The motion in `path`, resampled to `fps` (default: the file's own) and cut to its first
     /// `max_frames` (default: all). The cut is made before resampling too, so a long motion at a
     /// high frame rate costs only the frames played.
-    pub fn read_clip(path: &Path, fps: Option<f32>, max_frames: Option<NonZeroUsize>) -> Result<Self, BodyError> {
+    pub fn read_clip(
+        path: &Path,
+        fps: Option<f32>,
+        max_frames: Option<NonZeroUsize>,
+    ) -> Result<Self, BodyError> {
         let mut motion = Self::read(path)?;
         if let Some(n) = max_frames.map(NonZeroUsize::get) {
             // The source frames the first n resampled ones interpolate between, and one spare.
