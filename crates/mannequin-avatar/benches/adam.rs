@@ -12,7 +12,7 @@ use std::time::Instant;
 use burn::tensor::{DType, Device, Gradients, Tensor, TensorData};
 use mannequin_avatar::adam::Adam;
 use mannequin_avatar::params::Param;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// The optimiser before the fused op: one Burn tensor op per term.
 struct TensorOpAdam {

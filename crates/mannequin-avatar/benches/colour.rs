@@ -6,7 +6,7 @@
 
 use burn::tensor::{Device, Tensor, TensorData};
 use mannequin_avatar::sh_colour::{ColourConfig, sh_colour, sh_colour_tensors};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 mod timing;
 

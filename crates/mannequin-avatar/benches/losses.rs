@@ -23,7 +23,7 @@ use mannequin_avatar::losses::{
     MeshRegularisers, gaussian_blur_valid, gaussian_window, ssim, ssim_with_blur,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// The trainer's whole per-iteration budget on the 2-core CPU.
 const BUDGET_MS: f64 = 150.0;

@@ -7,7 +7,7 @@
 use burn::tensor::{Device, Tensor, TensorData};
 use mannequin_avatar::fused_mlp::mlp;
 use mannequin_avatar::mlp::mlp_tensors;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 mod timing;
 

@@ -38,7 +38,7 @@ use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
 use mannequin_data::Scores;
 use mannequin_data::evaluation::EvalOptions;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_synth::{SynthOptions, generate};
 
 fn ms(d: Duration) -> f64 {

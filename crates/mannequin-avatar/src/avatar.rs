@@ -22,7 +22,7 @@ use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
 use crate::params::{Param, tensor_from};
 use crate::sh_colour::{ColourConfig, colour_convention, sh_colour, sh_colour_tensors};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// Background of the colour channels: white, as the peers train and evaluate.
 pub const WHITE: [f64; 3] = [1.0; 3];

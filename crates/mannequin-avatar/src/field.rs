@@ -3,7 +3,7 @@
 //! The points never move, so their grid lookups are computed once.
 
 use burn::tensor::{DType, Device, Tensor};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 use crate::config::AvatarConfig;
 use crate::error::AvatarError;

@@ -5,7 +5,7 @@ use burn::tensor::{Device, Tensor, activation::relu};
 
 use crate::fused_mlp;
 use crate::params::{Param, tensor_from};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 #[derive(Clone, Debug)]
 pub struct Mlp {

@@ -1,7 +1,7 @@
 //! The record of a training run: every setting that changes what it produces, kept in the
 //! checkpoint as every run's record is ([`mannequin_io::run_record`]).
 
-use mannequin_data::fingerprint::Fingerprint;
+use mannequin_io::fingerprint::Fingerprint;
 use mannequin_io::run_record::{check_run, write_run};
 use mannequin_io::{Npz, NpzWriter};
 use serde::Serialize;

@@ -5,7 +5,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use burn::tensor::{Gradients, Tensor, TensorData};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_io::{NpyArray, NpzWriter};
 
 use crate::adam::Adam;

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::adam::Adam;
 use mannequin_avatar::params::Param;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_io::limits::FLOAT32;
 use mannequin_io::{Npz, NpzWriter};
 

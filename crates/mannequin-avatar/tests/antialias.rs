@@ -6,7 +6,7 @@ use burn::tensor::{Device, Tensor, TensorData};
 use mannequin_avatar::AVATAR_DILATION;
 use mannequin_avatar::antialias::compensation;
 use mannequin_avatar::mesh_gaussians::GaussianGeometry;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_splat::{Camera, Colors, Gaussians, RenderOptions, Rotations, project_gaussians};
 
 fn unit(v: [f64; 3]) -> [f64; 3] {

@@ -9,7 +9,7 @@ use mannequin_avatar::mesh_gaussians::{
     Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 fn host<const D: usize>(t: Tensor<D>) -> Vec<f32> {
     t.into_data().convert::<f32>().iter::<f32>().collect()

@@ -5,7 +5,7 @@
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::fused_mlp::{WIDTHS, mlp, supports};
 use mannequin_avatar::mlp::mlp_tensors;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 fn host(t: Tensor<2>) -> Vec<f32> {
     t.into_data().convert::<f32>().iter::<f32>().collect()

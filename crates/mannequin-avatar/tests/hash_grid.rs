@@ -7,7 +7,7 @@ use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::hash_grid::{
     Aabb, HashGridConfig, HashGridError, HashGridLookup, INIT_SCALE, encode, init_table, spatial_hash,
 };
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// The kernels' GPU device; without one the test fails with `GpuUnavailable`'s one line.
 fn wgpu() -> Device {

@@ -12,7 +12,7 @@ use mannequin_avatar::losses::{
 };
 use mannequin_data::Image;
 use mannequin_data::metrics::ssim::ssim as metric_ssim;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 fn tensor<const D: usize>(v: &[f64], shape: [usize; D], device: &Device, dtype: DType) -> Tensor<D> {
     Tensor::from_data(TensorData::new(v.to_vec(), shape), (device, dtype))

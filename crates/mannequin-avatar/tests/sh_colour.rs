@@ -4,7 +4,7 @@
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::sh_colour::{ColourConfig, sh_colour, sh_colour_tensors};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 fn host(t: Tensor<2>) -> Vec<f32> {
     t.into_data().convert::<f32>().iter::<f32>().collect()

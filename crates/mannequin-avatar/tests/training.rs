@@ -10,7 +10,7 @@ use mannequin_avatar::{
     TrainingRun, load_views,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::{Dataset, Fingerprint};
+use mannequin_data::Dataset;
 use mannequin_synth::{SynthOptions, generate};
 
 fn subject(name: &str) -> PathBuf {
@@ -53,7 +53,7 @@ fn record(t: &Trainer, data: &Path) -> TrainingRun {
         downscale: 1,
         skirt: SkirtMode::Off,
         garments: None,
-        data: Fingerprint::of(&dataset, &split).unwrap(),
+        data: dataset.fingerprint(&split).unwrap(),
         avatar: t.avatar.config.clone(),
         options: t.options.clone(),
     }

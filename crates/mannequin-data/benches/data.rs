@@ -16,7 +16,7 @@ use mannequin_data::metrics::{
     psnr::psnr,
     ssim::{ssim, ssim_direct},
 };
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
 

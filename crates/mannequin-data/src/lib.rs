@@ -13,7 +13,6 @@ pub mod layout;
 pub mod maps;
 pub mod metrics;
 pub mod poses;
-pub mod rng;
 pub mod scores;
 pub mod splits;
 pub mod staged;
@@ -21,7 +20,6 @@ pub mod writer;
 
 pub use dataset::{Cameras, Dataset, Frame, Split};
 pub use error::DataError;
-pub use fingerprint::Fingerprint;
 pub use image::{Image, Mask};
 /// The one camera type of the project, shared with the renderer.
 pub use mannequin_splat::Camera;

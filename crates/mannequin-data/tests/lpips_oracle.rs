@@ -3,7 +3,7 @@
 
 use mannequin_data::Image;
 use mannequin_data::metrics::lpips::{Lpips, weight_shapes};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 fn fixture() -> Npz {

@@ -15,7 +15,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 
 use mannequin_body::{Motion, parse_model};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_io::Npz;
 use mannequin_io::npy::parse_npy;
 use mannequin_mesh::Obj;

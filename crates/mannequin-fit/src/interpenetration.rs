@@ -112,7 +112,7 @@ mod tests {
 
     #[test]
     fn segment_distance_matches_dense_sampling() {
-        let mut rng = mannequin_data::rng::SplitMix64::new(7);
+        let mut rng = mannequin_io::rng::SplitMix64::new(7);
         let mut point = || {
             Vec3::new(rng.range(-0.5, 0.5) as f32, rng.range(-0.5, 0.5) as f32, rng.range(-0.5, 0.5) as f32)
         };

@@ -4,6 +4,7 @@
 
 pub mod atomic;
 pub mod error;
+pub mod fingerprint;
 pub mod limits;
 pub mod npy;
 pub mod npz;
@@ -12,6 +13,7 @@ pub mod pickle_arrays;
 pub mod ply_body;
 pub mod ply_header;
 pub mod progress;
+pub mod rng;
 pub mod run_record;
 
 pub use atomic::{write_atomic, write_atomic_with};

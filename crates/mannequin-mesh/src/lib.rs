@@ -9,6 +9,7 @@ pub mod file_error;
 pub mod gltf;
 pub mod gradient;
 pub mod jacobian_field;
+pub mod kdtree;
 pub mod laplacian;
 pub mod manifold;
 pub mod mass;

@@ -2,7 +2,7 @@
 //! form (the antialiased coverage of a square is its area).
 
 use mannequin_data::Camera;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_raster::differentiable::render;
 
 fn camera(w: usize, h: usize) -> Camera {

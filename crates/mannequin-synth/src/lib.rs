@@ -157,7 +157,7 @@ pub fn generate(
     let subject = Subject::random(options.seed, model.num_betas().min(10));
     let scene = Scene::new(model, &subject)?;
     let mut rng =
-        mannequin_data::rng::SplitMix64::new(options.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xCA97);
+        mannequin_io::rng::SplitMix64::new(options.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xCA97);
 
     // The capture: one camera, the subject turning. The camera also frames the novel poses,
     // which are seen from it too.

@@ -6,7 +6,7 @@ use std::f32::consts::TAU;
 use mannequin_body::smpl_joint::*;
 use mannequin_body::{BodyError, Motion, named_pose};
 
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// SMPL joints that sway a little while the subject holds the A-pose.
 const SWAY_JOINTS: [usize; 9] =

@@ -19,7 +19,7 @@ use mannequin_data::image::{Image, Mask};
 use mannequin_data::labels::LabelMap;
 use mannequin_data::maps::{DepthMap, NormalMap};
 use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// Texture size of the body's UV atlas and of each garment's triangle atlas beside it (square,
 /// all one size, so the atlas's rows line up).

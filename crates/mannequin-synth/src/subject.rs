@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 /// The clothing variants, each a few garments of the library (see [`Outfit::garments`]); the
 /// skirt and the dress bridge the legs, so the body model alone cannot explain the silhouette.

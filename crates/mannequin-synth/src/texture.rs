@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use crate::subject::{GarmentLook, Pattern, Subject};
 use mannequin_data::image::Image;
-use mannequin_data::rng::mix;
+use mannequin_io::rng::mix;
 
 /// What a surface point is, for colouring.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -18,7 +18,7 @@ use std::process::Command;
 use glam::{DQuat, DVec3};
 use mannequin_body::{BodyModel, FaceModel};
 use mannequin_data::Image;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_fit::body_fit::picture_camera;
 use mannequin_fit::face_landmark_table::FaceLandmarkTable;
 use mannequin_fit::face_render::{LitHead, render_head};

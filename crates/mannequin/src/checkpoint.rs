@@ -15,7 +15,7 @@ pub const CHECKPOINT: &str = "checkpoint.npz";
 /// The hash of a file's bytes: tells an edited input from the one a checkpoint ran.
 pub fn file_hash(path: &Path) -> Result<String> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    Ok(mannequin_data::fingerprint::hash_bytes(&bytes))
+    Ok(mannequin_io::fingerprint::hash_bytes(&bytes))
 }
 
 /// Stores `run` (everything that changes the result) as the checkpoint's record.

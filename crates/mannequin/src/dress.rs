@@ -364,7 +364,7 @@ fn template_hash(g: &Garment) -> String {
     bytes.extend(floats.flat_map(|x| x.to_le_bytes()));
     let indices = g.mesh.faces.iter().flatten().chain(g.binding.iter().map(|b| &b.face));
     bytes.extend(indices.flat_map(|i| i.to_le_bytes()));
-    mannequin_data::fingerprint::hash_bytes(&bytes)
+    mannequin_io::fingerprint::hash_bytes(&bytes)
 }
 
 /// Finished layers as `finished_<i>`, the one under way as `current` with the cloth's state.

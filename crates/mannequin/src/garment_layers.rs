@@ -6,7 +6,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use mannequin_avatar::garment_layer::GarmentLayer;
-use mannequin_data::{Fingerprint, layout};
+use mannequin_data::layout;
+use mannequin_io::fingerprint::Fingerprint;
 use mannequin_garment::Category;
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 

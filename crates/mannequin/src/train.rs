@@ -12,7 +12,7 @@ use mannequin_avatar::{
     Trainer, TrainingRun, load_views,
 };
 use mannequin_body::BodyModel;
-use mannequin_data::{Dataset, Fingerprint};
+use mannequin_data::Dataset;
 
 use crate::compute::Compute;
 use crate::garment_layers;
@@ -153,7 +153,7 @@ pub fn prepare(args: &Args) -> Result<(Trainer, TrainingRun)> {
             categories: garments.iter().map(|c| c.name().to_string()).collect(),
             steps: args.garment_iters,
         }),
-        data: Fingerprint::of(&dataset, &split)?,
+        data: dataset.fingerprint(&split)?,
         avatar: avatar_config(args),
         options: train_options(args),
     };

@@ -2,7 +2,7 @@
 //! starts near zero and the MLP behind it starts from a near-constant input.
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 use super::HashGridConfig;
 

@@ -13,7 +13,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::kdtree::KdTree;
+use mannequin_mesh::kdtree::KdTree;
 use super::surface_distance::TriangleBvh;
 use super::surface_sampling::{SurfaceSamples, sample_surface};
 use mannequin_mesh::TriMesh;

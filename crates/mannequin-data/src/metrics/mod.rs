@@ -1,7 +1,6 @@
 //! The metrics the papers report, computed as the reference implementations compute them.
 
 pub mod geometry;
-pub mod kdtree;
 pub mod lpips;
 pub mod normal_error;
 pub mod point_triangle;

@@ -49,7 +49,7 @@ mod tests {
     #[test]
     fn agrees_with_a_dense_search_in_every_region() {
         let (a, b, c) = (DVec3::new(0.0, 0.0, 0.0), DVec3::new(2.0, 0.1, 0.0), DVec3::new(0.4, 1.5, 0.3));
-        let mut r = crate::rng::SplitMix64::new(11);
+        let mut r = mannequin_io::rng::SplitMix64::new(11);
         for _ in 0..200 {
             let p = DVec3::new(r.range(-2.0, 4.0), r.range(-2.0, 3.0), r.range(-1.0, 1.0));
             let q = closest_point_on_triangle(p, a, b, c);

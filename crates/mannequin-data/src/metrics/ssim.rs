@@ -229,7 +229,7 @@ mod tests {
 
     #[test]
     fn identical_images_score_one_and_direct_matches_fast() {
-        let mut r = crate::rng::SplitMix64::new(3);
+        let mut r = mannequin_io::rng::SplitMix64::new(3);
         let a = Image {
             width: 23,
             height: 17,
@@ -256,7 +256,7 @@ mod tests {
 
     #[test]
     fn plane_gradient_matches_finite_differences() {
-        let mut r = crate::rng::SplitMix64::new(11);
+        let mut r = mannequin_io::rng::SplitMix64::new(11);
         let (w, h) = (14, 12);
         let x: Vec<f64> = (0..w * h).map(|_| r.uniform()).collect();
         let y: Vec<f64> = x.iter().map(|v| (0.7 * v + 0.2 * r.uniform()).min(1.0)).collect();

@@ -129,7 +129,7 @@ mod tests {
 
     #[test]
     fn matches_brute_force_over_all_triangles() {
-        let mut r = crate::rng::SplitMix64::new(9);
+        let mut r = mannequin_io::rng::SplitMix64::new(9);
         let positions: Vec<[f32; 3]> = (0..300).map(|_| [0; 3].map(|_| r.normal() as f32)).collect();
         let faces: Vec<[u32; 3]> = (0..200).map(|_| [0; 3].map(|_| r.below(300) as u32)).collect();
         let bvh = TriangleBvh::new(&positions, &faces);

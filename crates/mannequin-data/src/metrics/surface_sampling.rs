@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use crate::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceSamples {

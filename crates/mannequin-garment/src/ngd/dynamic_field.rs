@@ -7,7 +7,7 @@
 //! garment. Forward and backward are written out (ReLU layers), with Adam on every weight.
 
 use glam::DVec3;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_mesh::poisson::Jacobian;
 use rayon::prelude::*;
 

@@ -5,7 +5,7 @@
 use std::time::Instant;
 
 use mannequin_data::Camera;
-use mannequin_data::rng::SplitMix64;
+use mannequin_io::rng::SplitMix64;
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::manifold::check_manifold;
 use serde::Serialize;

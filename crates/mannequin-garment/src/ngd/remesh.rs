@@ -7,7 +7,7 @@
 //! old face centres or vertices (Eqs. 9–10).
 
 use glam::DVec3;
-use mannequin_data::metrics::kdtree::KdTree;
+use mannequin_mesh::kdtree::KdTree;
 use mannequin_mesh::poisson::Jacobian;
 use mannequin_mesh::remesh::split_and_flip;
 use serde::Serialize;

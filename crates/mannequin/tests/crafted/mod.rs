@@ -100,7 +100,7 @@ pub fn broken_bytes(good: &[u8]) -> Vec<(String, Vec<u8>)> {
     for share in [10, 50, 90] {
         out.push((format!("cut_{share}"), good[..good.len() * share / 100].to_vec()));
     }
-    let mut rng = mannequin_data::rng::SplitMix64::new(42);
+    let mut rng = mannequin_io::rng::SplitMix64::new(42);
     out.push(("random".to_string(), (0..good.len().max(64)).map(|_| rng.next_u64() as u8).collect()));
     out
 }

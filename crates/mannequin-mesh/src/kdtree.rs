@@ -101,7 +101,7 @@ mod tests {
 
     #[test]
     fn matches_brute_force() {
-        let mut r = crate::rng::SplitMix64::new(5);
+        let mut r = mannequin_io::rng::SplitMix64::new(5);
         let mut pt = || DVec3::new(r.normal(), r.normal() * 0.3, r.uniform());
         let points: Vec<DVec3> = (0..2000).map(|_| pt()).collect();
         let tree = KdTree::new(&points);
@@ -117,7 +117,7 @@ mod tests {
 
     #[test]
     fn k_nearest_matches_brute_force() {
-        let mut r = crate::rng::SplitMix64::new(7);
+        let mut r = mannequin_io::rng::SplitMix64::new(7);
         let mut pt = || DVec3::new(r.normal(), r.uniform(), r.normal() * 2.0);
         let points: Vec<DVec3> = (0..1500).map(|_| pt()).collect();
         let tree = KdTree::new(&points);
