@@ -13,6 +13,8 @@ pub enum AvatarError {
     #[error(transparent)]
     Splat(#[from] mannequin_splat::SplatError),
     #[error(transparent)]
+    Gpu(#[from] mannequin_splat::GpuUnavailable),
+    #[error(transparent)]
     HashGrid(#[from] crate::hash_grid::HashGridError),
     #[error("{path}: {reason}")]
     File { path: PathBuf, reason: String },
@@ -20,10 +22,18 @@ pub enum AvatarError {
     Invalid(String),
     #[error("the loss became {value} at iteration {iteration}; the last good checkpoint is {checkpoint}")]
     NonFiniteLoss { iteration: usize, value: f64, checkpoint: String },
+    /// A checkpoint that cannot be resumed, with the way out.
+    #[error("{0}; use --restart to start over, or another --out")]
+    CannotResume(Box<AvatarError>),
 }
 
 impl AvatarError {
     pub fn file(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
         Self::File { path: path.into(), reason: reason.into() }
+    }
+
+    /// This error, refusing a checkpoint, with the way out.
+    pub fn cannot_resume(self) -> Self {
+        Self::CannotResume(Box::new(self))
     }
 }

@@ -57,7 +57,7 @@ const OUTLINE_STRIP: f32 = 0.02;
 const MIN_RADIUS: f32 = 0.05;
 
 /// Whether to add the layer: when the masks show a skirt, or never.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum SkirtMode {
     Auto,

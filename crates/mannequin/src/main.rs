@@ -6,7 +6,6 @@ mod body;
 mod capture;
 mod checkpoint;
 mod cloth;
-mod compute;
 mod demo;
 mod dress;
 mod eval;
