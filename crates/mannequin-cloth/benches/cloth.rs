@@ -41,7 +41,7 @@ fn grid_run(nx: usize, ny: usize, self_collision: bool, frames: usize) -> f64 {
     let mesh = common::grid(nx, ny, 0.01, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
     let pins: Vec<u32> = (0..nx as u32).collect();
     let cloth = Cloth::new(&mesh, &Material::named("cotton").expect("cotton"), &pins).expect("cloth");
-    let settings = Settings { substeps: 10, self_collision, ..Settings::default() };
+    let settings = Settings { substeps: Settings::substeps_at(60.0), self_collision, ..Settings::default() };
     let mut sim = Simulator::new(cloth, None, Vec::new(), settings).expect("simulator");
     let start = Instant::now();
     for _ in 0..frames {
@@ -130,7 +130,7 @@ fn walking_garment(frames: usize) {
     let attachments =
         band.iter().map(|&v| Attachment::bind(&rest, &faces, v, garment.positions[v as usize])).collect();
     let cloth = Cloth::new(&garment, &Material::named("cotton").expect("cotton"), &[]).expect("cloth");
-    let settings = Settings { substeps: 20, ..Settings::default() };
+    let settings = Settings::default();
     let mut sim =
         Simulator::new(cloth, Some(Body::new(faces.clone())), attachments, settings).expect("simulator");
     let mut previous = rest;

@@ -5,7 +5,7 @@ use mannequin_mesh::{TriMesh, UvLayout};
 
 use crate::bending::BendingConstraints;
 use crate::error::ClothError;
-use crate::garment_check::{check_pins, checked_topology};
+use crate::garment_check::{check_pins, checked_constraint_graph};
 use crate::material::Material;
 use crate::rest_shape::RestShape;
 use crate::stretch::StretchConstraints;
@@ -49,7 +49,7 @@ impl Cloth {
         pins: &[u32],
     ) -> Result<Cloth, ClothError> {
         material.validate()?;
-        let topology = checked_topology(mesh)?;
+        let graph = checked_constraint_graph(mesh)?;
         check_pins(pins, mesh.positions.len())?;
         let n = mesh.positions.len();
         let mass = rest.masses(&mesh.faces, n, material.density);
@@ -57,11 +57,11 @@ impl Cloth {
         for &p in pins {
             inverse_mass[p as usize] = 0.0;
         }
-        let lengths = rest.edge_lengths(&mesh.faces, &topology);
-        let hinges = rest.hinges(&mesh.faces, &topology);
+        let lengths = rest.edge_lengths(&mesh.faces, &graph);
+        let hinges = rest.hinges(&mesh.faces, &graph);
         Ok(Cloth {
-            stretch: StretchConstraints::new(&topology.edges, &lengths, n, material.stretch_compliance),
-            bending: BendingConstraints::new(&topology.hinges, &hinges, n, material.bend_compliance),
+            stretch: StretchConstraints::new(&graph.edges, &lengths, n, material.stretch_compliance),
+            bending: BendingConstraints::new(&graph.hinges, &hinges, n, material.bend_compliance),
             faces: mesh.faces.clone(),
             inverse_mass,
             start: mesh.positions.clone(),

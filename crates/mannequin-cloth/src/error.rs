@@ -2,8 +2,9 @@
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ClothError {
-    #[error("material: unknown name {name:?}; the materials are {}", crate::material::MATERIAL_NAMES.join(", "))]
-    UnknownMaterial { name: String },
+    /// `known`: the material names, listed.
+    #[error("material: unknown name {name:?}; the materials are {known}")]
+    UnknownMaterial { name: String, known: String },
     #[error("{field}: {reason}")]
     Invalid { field: String, reason: String },
     #[error("{field}[{index}] is not finite")]

@@ -6,8 +6,8 @@
 use glam::DVec3;
 use mannequin_mesh::{MeshError, TriMesh, manifold::check_manifold};
 
+use crate::constraint_graph::{ConstraintGraph, constraint_graph};
 use crate::error::ClothError;
-use crate::topology::{Topology, topology};
 
 /// A triangle is degenerate when its area is below this fraction of its longest edge squared,
 /// i.e. when its smallest angle is under about a microradian.
@@ -24,11 +24,11 @@ pub const MAX_GARMENT_FACES: usize = 2 * MAX_GARMENT_VERTICES;
 /// Refuses a garment mesh the solver cannot simulate: every fault is named with its field and
 /// index (a caller prefixes its file).
 pub fn check_garment(mesh: &TriMesh) -> Result<(), ClothError> {
-    checked_topology(mesh).map(drop)
+    checked_constraint_graph(mesh).map(drop)
 }
 
 /// [`check_garment`], giving the constraint graph it built on the way.
-pub(crate) fn checked_topology(mesh: &TriMesh) -> Result<Topology, ClothError> {
+pub(crate) fn checked_constraint_graph(mesh: &TriMesh) -> Result<ConstraintGraph, ClothError> {
     let count = mesh.positions.len();
     for (field, n, max) in
         [("positions", count, MAX_GARMENT_VERTICES), ("faces", mesh.faces.len(), MAX_GARMENT_FACES)]
@@ -51,7 +51,7 @@ pub(crate) fn checked_topology(mesh: &TriMesh) -> Result<Topology, ClothError> {
             return Err(ClothError::DegenerateFace { face });
         }
     }
-    let topology = topology(&mesh.faces)?;
+    let graph = constraint_graph(&mesh.faces)?;
     check_manifold(&mesh.positions, &mesh.faces).map_err(|e| match e {
         MeshError::NotManifold(reason) => ClothError::invalid("faces", reason),
         other => ClothError::invalid("faces", other.to_string()),
@@ -64,7 +64,7 @@ pub(crate) fn checked_topology(mesh: &TriMesh) -> Result<Topology, ClothError> {
             format!("vertex {v} is in no triangle; expected every vertex in one (a loose point has no mass)"),
         ));
     }
-    Ok(topology)
+    Ok(graph)
 }
 
 /// Refuses pins naming a vertex past the garment's `count`.

@@ -8,6 +8,13 @@
 //! 1 gf·cm²/cm ≈ 9.8e-5 N·m. Damping stands in for air drag: linearised drag at 1 m/s,
 //! ½·ρ_air·C_d ≈ 0.7 N·s/m³, divided by the areal density and halved, since air resists only
 //! the motion across the sheet.
+//!
+//! A material is named once, where it is read (a command-line flag, a run record), and travels as
+//! this type from there.
+
+use std::str::FromStr;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::ClothError;
 
@@ -23,6 +30,9 @@ pub struct Material {
 }
 
 pub const MATERIAL_NAMES: [&str; 5] = ["cotton", "denim", "silk", "jersey", "leather"];
+
+/// Every named fabric, in the order of [`MATERIAL_NAMES`].
+static MATERIALS: [Material; 5] = [COTTON, DENIM, SILK, JERSEY, LEATHER];
 
 /// Cotton shirting: ~150 g/m²; woven, tensile stiffness ~2000 N/m; bending ~0.05 gf·cm²/cm
 /// (5e-6 N·m); cotton on skin μ ≈ 0.5.
@@ -86,10 +96,10 @@ const LEATHER: Material = Material {
 impl Material {
     /// The fabric called `name` (one of [`MATERIAL_NAMES`]).
     pub fn named(name: &str) -> Result<Material, ClothError> {
-        [COTTON, DENIM, SILK, JERSEY, LEATHER]
-            .into_iter()
-            .find(|m| m.name == name)
-            .ok_or_else(|| ClothError::UnknownMaterial { name: name.to_string() })
+        MATERIALS.into_iter().find(|m| m.name == name).ok_or_else(|| ClothError::UnknownMaterial {
+            name: name.to_string(),
+            known: MATERIAL_NAMES.join(", "),
+        })
     }
 
     /// Refuses negative or non-finite parameters, and a zero density (a particle needs mass).
@@ -117,6 +127,51 @@ impl Material {
     }
 }
 
+impl Default for Material {
+    fn default() -> Self {
+        COTTON
+    }
+}
+
+impl FromStr for Material {
+    type Err = ClothError;
+
+    fn from_str(name: &str) -> Result<Self, ClothError> {
+        Material::named(name)
+    }
+}
+
+impl std::fmt::Display for Material {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+/// `--material <name>`: one of the named fabrics, refused by clap listing them.
+impl clap::ValueEnum for Material {
+    fn value_variants<'a>() -> &'a [Self] {
+        &MATERIALS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name))
+    }
+}
+
+/// A material is stored by its name.
+impl Serialize for Material {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name)
+    }
+}
+
+impl<'de> Deserialize<'de> for Material {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        Material::named(&name).map_err(serde::de::Error::custom)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,6 +183,15 @@ mod tests {
             assert_eq!(m.name, name);
             m.validate().unwrap();
         }
+    }
+
+    #[test]
+    fn a_material_is_parsed_and_stored_by_its_name() {
+        let denim: Material = "denim".parse().unwrap();
+        assert_eq!(denim, Material::named("denim").unwrap());
+        assert_eq!(serde_json::to_string(&denim).unwrap(), "\"denim\"");
+        assert_eq!(serde_json::from_str::<Material>("\"denim\"").unwrap(), denim);
+        assert!(serde_json::from_str::<Material>("\"tweed\"").unwrap_err().to_string().contains("tweed"));
     }
 
     #[test]

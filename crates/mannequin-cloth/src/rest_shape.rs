@@ -6,9 +6,9 @@
 use glam::Vec3;
 use mannequin_mesh::{TriMesh, UvLayout};
 
+use crate::constraint_graph::ConstraintGraph;
 use crate::dihedral::Hinge;
 use crate::error::ClothError;
-use crate::topology::Topology;
 
 /// Per face, its three corners at rest; `flat` when they come from a pattern, whose hinges then
 /// rest at angle 0.
@@ -75,22 +75,22 @@ impl RestShape {
 
     /// Each edge's rest length, the mean over the faces on its sides (which agree unless a seam
     /// joins panel edges of different lengths).
-    pub fn edge_lengths(&self, faces: &[[u32; 3]], topology: &Topology) -> Vec<f32> {
-        topology
+    pub fn edge_lengths(&self, faces: &[[u32; 3]], graph: &ConstraintGraph) -> Vec<f32> {
+        graph
             .edges
             .iter()
-            .zip(&topology.edge_faces)
+            .zip(&graph.edge_faces)
             .map(|(&edge, sides)| {
                 0.5 * sides.iter().map(|&f| self.edge(faces, f, edge).length()).sum::<f32>()
             })
             .collect()
     }
 
-    pub fn hinges(&self, faces: &[[u32; 3]], topology: &Topology) -> Vec<HingeRest> {
-        topology
+    pub fn hinges(&self, faces: &[[u32; 3]], graph: &ConstraintGraph) -> Vec<HingeRest> {
+        graph
             .hinges
             .iter()
-            .zip(&topology.hinge_faces)
+            .zip(&graph.hinge_faces)
             .map(|(&[a, b, c, d], &[f, g])| {
                 let angle = if self.flat {
                     0.0
@@ -126,7 +126,7 @@ fn area([a, b, c]: &[Vec3; 3]) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::topology::topology;
+    use crate::constraint_graph::constraint_graph;
 
     /// A quad folded 90° about its diagonal: sewn from a flat pattern twice its size, its edges
     /// take the pattern's lengths and its hinge rests flat; cut from the folded mesh, the hinge
@@ -142,7 +142,7 @@ mod tests {
             coords: vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0], [2.0, 2.0]],
             faces: vec![[0, 1, 2], [2, 1, 3]],
         };
-        let t = topology(&mesh.faces).unwrap();
+        let t = constraint_graph(&mesh.faces).unwrap();
         let sewn = RestShape::of_pattern(&mesh, &layout).unwrap();
         let lengths = sewn.edge_lengths(&mesh.faces, &t);
         // Edges [0,1], [0,2], [1,2], [1,3], [2,3] at the pattern's scale.

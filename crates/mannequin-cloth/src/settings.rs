@@ -3,6 +3,15 @@
 
 use crate::error::ClothError;
 
+/// Substeps per frame, the one default for every caller (`cloth simulate`, `dress`, draping a
+/// panel, the synthetic subjects): tuned at [`SUBSTEPS_TUNED_FPS`] frames per second, where at
+/// half of it a T-shirt slides off the shoulders in the walk.
+pub const SUBSTEPS: u32 = 20;
+
+/// The frame rate (1/s) [`SUBSTEPS`] was tuned at: 20 substeps per 1/30 s frame are 600 substeps
+/// per second.
+pub const SUBSTEPS_TUNED_FPS: f32 = 30.0;
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
     /// Substeps per frame; each substep predicts, projects and updates velocities.
@@ -21,7 +30,7 @@ pub struct Settings {
 impl Default for Settings {
     fn default() -> Self {
         Self {
-            substeps: 10,
+            substeps: SUBSTEPS,
             iterations: 1,
             gravity: [0.0, -9.81, 0.0],
             thickness: 0.005,
@@ -32,6 +41,13 @@ impl Default for Settings {
 }
 
 impl Settings {
+    /// Substeps per frame at `fps` frames per second that step as finely in time as
+    /// [`SUBSTEPS`] does at [`SUBSTEPS_TUNED_FPS`] (600 per second), for a caller whose frame
+    /// rate varies.
+    pub fn substeps_at(fps: f32) -> u32 {
+        (SUBSTEPS as f32 * SUBSTEPS_TUNED_FPS / fps).ceil() as u32
+    }
+
     pub fn validate(&self) -> Result<(), ClothError> {
         if self.substeps == 0 {
             return Err(ClothError::invalid("settings.substeps", "must be at least 1"));

@@ -11,7 +11,8 @@ fn run() -> Vec<[f32; 3]> {
     let sphere = icosphere([0.0, 0.0, 0.0], 0.1, 3);
     let sheet = grid(31, 31, 0.01, [-0.15, 0.12, -0.15], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
     let cloth = Cloth::new(&sheet, &Material::named("silk").unwrap(), &[]).unwrap();
-    let settings = Settings { self_collision: true, ..Settings::default() };
+    let settings =
+        Settings { self_collision: true, substeps: Settings::substeps_at(60.0), ..Settings::default() };
     let mut sim = Simulator::new(cloth, Some(Body::new(sphere.faces.clone())), Vec::new(), settings).unwrap();
     for _ in 0..40 {
         sim.step_frame(&sphere.positions, &sphere.positions, 1.0 / 60.0).unwrap();

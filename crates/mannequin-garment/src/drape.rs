@@ -20,8 +20,8 @@ pub fn drape(panel: &Panel, material: &Material, body: &TriMesh) -> Result<Vec<[
     let pins: Vec<u32> = (0..panel.seam as u32).collect();
     let material = Material { damping: material.damping.max(DAMPING), ..*material };
     let cloth = Cloth::sewn(&panel.mesh, &panel.pattern, &material, &pins)?;
-    let settings = Settings { substeps: 20, ..Settings::default() };
-    let mut sim = Simulator::new(cloth, Some(Body::new(body.faces.clone())), Vec::new(), settings)?;
+    let mut sim =
+        Simulator::new(cloth, Some(Body::new(body.faces.clone())), Vec::new(), Settings::default())?;
     for _ in 0..FRAMES {
         sim.step_frame(&body.positions, &body.positions, 1.0 / 30.0)?;
     }

@@ -28,9 +28,6 @@ const TEXTURE: usize = 2048;
 const ATLAS_MARGIN: f32 = 0.12;
 /// Seconds the garments settle on the body before each sequence's first frame.
 const SETTLE_SECONDS: f32 = 1.0;
-/// Cloth substeps per second of motion: `mannequin dress`'s at 30 fps (at half that, a T-shirt
-/// slides off the shoulders in the walk).
-const SUBSTEPS_PER_SECOND: f32 = 600.0;
 
 /// Where a camera looks from, relative to the subject's bounding box centre: azimuth about +Y
 /// (0 is in front, on +Z), elevation, distance as a multiple of 3.3 m, and roll.
@@ -319,8 +316,8 @@ impl Scene {
             .map_err(fail)?;
         let named: Vec<(&str, &Dressed)> = self.worn.iter().zip(&dressed).map(|(w, d)| (w.name, d)).collect();
         let wearer = Wearer { faces: &self.body_faces, frames: &body_frames, schedule: &schedule, fps };
-        let substeps = (SUBSTEPS_PER_SECOND / fps).ceil() as u32;
-        let settings = Settings { substeps, self_collision: false, ..Settings::default() };
+        let settings =
+            Settings { substeps: Settings::substeps_at(fps), self_collision: false, ..Settings::default() };
         let layers =
             wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |_| Ok(()))
                 .map_err(fail)?;

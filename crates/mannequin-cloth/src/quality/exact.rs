@@ -6,6 +6,9 @@
 
 use std::cmp::Ordering;
 
+/// A point in f64, where the exact tests work.
+pub(crate) type Point = [f64; 3];
+
 /// Shewchuk's ccwerrboundA and o3derrboundA, (3 + 16ε)ε and (7 + 56ε)ε, rounded up.
 const ORIENT2D_BOUND: f64 = 3.4e-16;
 const ORIENT3D_BOUND: f64 = 7.8e-16;

@@ -5,7 +5,8 @@
 
 use std::collections::HashMap;
 
-use super::triangle_intersection::{Point, triangles_intersect};
+use super::exact::Point;
+use super::triangle_intersection::triangles_intersect;
 
 /// A box spanning more grid cells than this along an axis is tested against every other box
 /// rather than listed in the cells it covers: one triangle stretched across the scene (a particle

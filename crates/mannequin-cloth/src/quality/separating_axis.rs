@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use super::triangle_intersection::Point;
+use super::exact::Point;
 
 /// Relative bound on the rounding of one projection a·x (three products and two sums, each
 /// within 2⁻⁵³ of its value) with a wide safety factor.

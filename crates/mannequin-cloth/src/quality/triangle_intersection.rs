@@ -4,10 +4,8 @@
 
 use std::cmp::Ordering::{self, Equal, Greater, Less};
 
-use super::exact::{orient2d, orient3d};
+use super::exact::{Point, orient2d, orient3d};
 use super::separating_axis::certainly_apart;
-
-pub(crate) type Point = [f64; 3];
 
 /// True when the closed triangles `p` and `q` intersect (touching counts). A degenerate triangle
 /// (its corners on one line) meets nothing.

@@ -12,7 +12,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::crossing::{between, coplanar_time, volume};
-use super::{Neighbours, Reach, push_apart};
+use super::neighbours::Neighbours;
+use super::push::{Reach, push_apart};
 use crate::box_hash::{Aabb, BoxHash};
 
 /// Closest points this close to an edge's end (as a fraction of it) count as at the end.

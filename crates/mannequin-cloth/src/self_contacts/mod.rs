@@ -13,6 +13,7 @@
 mod crossing;
 mod edge_edge;
 mod neighbours;
+mod push;
 mod vertex_triangle;
 
 use glam::Vec3;
@@ -21,6 +22,7 @@ use rayon::prelude::*;
 use crate::box_hash::Aabb;
 use edge_edge::EdgeEdge;
 use neighbours::Neighbours;
+use push::Reach;
 use vertex_triangle::VertexTriangle;
 
 /// The slack s per frame is this many thicknesses, plus [`BODY_SLACK`] times the body's travel per
@@ -30,55 +32,6 @@ const BODY_SLACK: f32 = 4.0;
 /// Of the slack, this share bounds the clamped prediction and the body's push; the rest covers
 /// the small moves of the other constraints.
 const SLACK_USE: f32 = 0.9;
-/// The share of h kept between elements that are neighbours along an edge. Within one layer, a
-/// little compression brings a vertex over its neighbours' triangles with no side to tell apart,
-/// and a full h there would throw it out of the layer; the sliver still keeps a tight fold from
-/// passing through itself.
-const NEIGHBOUR_GAP: f32 = 0.3;
-
-/// How far candidates are looked for, and the gap a contact keeps.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Reach {
-    pub distance: f32,
-    pub thickness: f32,
-}
-
-impl Reach {
-    /// The gap between two elements: h, or a sliver of it when they are `near` neighbours.
-    pub fn gap(&self, near: bool) -> f32 {
-        if near { NEIGHBOUR_GAP * self.thickness } else { self.thickness }
-    }
-}
-
-/// How far each of up to four particles moves, per unit of violation, along the push: `share` is
-/// each particle's part of the constraint's gradient. No particle moves farther than the violation
-/// itself: where only a corner with a small share is free, the exact projection would throw it by
-/// the violation over that share. `None` when nothing can move.
-fn push_weights(inverse_mass: [f32; 4], share: [f32; 4]) -> Option<[f32; 4]> {
-    let weight: f32 = (0..4).map(|k| inverse_mass[k] * share[k] * share[k]).sum();
-    let largest = (0..4).map(|k| inverse_mass[k] * share[k].abs()).fold(0.0, f32::max);
-    let denominator = weight.max(largest);
-    (denominator > 0.0).then(|| [0, 1, 2, 3].map(|k| inverse_mass[k] * share[k] / denominator))
-}
-
-/// Moves four particles along `push` (the full correction, as if the free corners carried it all)
-/// in the shares [`push_weights`] gives them.
-fn push_apart(
-    positions: &mut [[f32; 3]],
-    particles: [u32; 4],
-    inverse_mass: &[f32],
-    share: [f32; 4],
-    push: Vec3,
-) {
-    let Some(moves) = push_weights(particles.map(|i| inverse_mass[i as usize]), share) else {
-        return;
-    };
-    for k in 0..4 {
-        let p = &mut positions[particles[k] as usize];
-        *p = (Vec3::from(*p) + moves[k] * push).to_array();
-    }
-}
-
 #[derive(Debug, Clone)]
 pub(crate) struct SelfContacts {
     neighbours: Neighbours,

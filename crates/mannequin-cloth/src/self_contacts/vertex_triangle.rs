@@ -11,7 +11,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::crossing::{between, coplanar_time, volume};
-use super::{Neighbours, Reach, push_apart};
+use super::neighbours::Neighbours;
+use super::push::{Reach, push_apart};
 use crate::box_hash::{Aabb, BoxHash};
 use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 

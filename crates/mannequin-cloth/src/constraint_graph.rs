@@ -5,7 +5,7 @@
 use crate::error::ClothError;
 
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Topology {
+pub(crate) struct ConstraintGraph {
     /// Every edge once, `[low, high]`, sorted.
     pub edges: Vec<[u32; 2]>,
     /// The faces on each side of each edge (the same face twice on a boundary).
@@ -16,7 +16,7 @@ pub(crate) struct Topology {
     pub hinge_faces: Vec<[usize; 2]>,
 }
 
-pub(crate) fn topology(faces: &[[u32; 3]]) -> Result<Topology, ClothError> {
+pub(crate) fn constraint_graph(faces: &[[u32; 3]]) -> Result<ConstraintGraph, ClothError> {
     let mut sides: Vec<([u32; 2], u32, usize)> = faces
         .iter()
         .enumerate()
@@ -48,7 +48,7 @@ pub(crate) fn topology(faces: &[[u32; 3]]) -> Result<Topology, ClothError> {
         }
         edges.push([a, b]);
     }
-    Ok(Topology { edges, edge_faces, hinges, hinge_faces })
+    Ok(ConstraintGraph { edges, edge_faces, hinges, hinge_faces })
 }
 
 #[cfg(test)]
@@ -57,7 +57,7 @@ mod tests {
 
     #[test]
     fn a_quad_has_five_edges_and_one_hinge() {
-        let t = topology(&[[0, 1, 2], [2, 1, 3]]).unwrap();
+        let t = constraint_graph(&[[0, 1, 2], [2, 1, 3]]).unwrap();
         assert_eq!(t.edges, vec![[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]);
         assert_eq!(t.hinges, vec![[1, 2, 0, 3]]);
         assert_eq!(t.hinge_faces, vec![[0, 1]]);
@@ -67,7 +67,7 @@ mod tests {
 
     #[test]
     fn a_fin_of_three_triangles_is_refused() {
-        let e = topology(&[[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap_err();
+        let e = constraint_graph(&[[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap_err();
         assert_eq!(
             e.to_string(),
             "faces: edge (0, 1) is shared by 3 triangles; a cloth edge may have at most 2"
@@ -76,7 +76,7 @@ mod tests {
 
     #[test]
     fn a_repeated_triangle_is_refused() {
-        let e = topology(&[[0, 1, 2], [2, 1, 0]]).unwrap_err();
+        let e = constraint_graph(&[[0, 1, 2], [2, 1, 0]]).unwrap_err();
         assert_eq!(e.to_string(), "faces: faces[0] and faces[1] are the same triangle");
     }
 }

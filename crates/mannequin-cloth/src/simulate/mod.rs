@@ -1,0 +1,199 @@
+//! `cloth simulate`'s run: drape a garment on a body and play a motion with the XPBD simulator.
+//! The body starts at rest and blends into the motion's first frame over a settling period, so
+//! the garment hangs before the motion starts. Checkpoints let a re-run of the same run resume;
+//! a state that goes non-finite stops the run and keeps the frames before it.
+
+mod metrics;
+mod outputs;
+mod pins;
+mod placement;
+mod progress;
+mod settings;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use mannequin_body::{BodyModel, Motion, Settling, pose_frames, shape_body};
+use mannequin_mesh::{TriMesh, points, read_obj};
+
+use crate::attachment::Attachment;
+use crate::body::Body;
+use crate::cloth::Cloth;
+use crate::phase_times::PhaseTimes;
+use crate::run_checkpoint::{CHECKPOINT, file_hash};
+use crate::settings::Settings;
+use crate::sim_limits::check_kept_positions;
+use crate::simulate_error::SimulateError;
+use crate::simulator::Simulator;
+use metrics::FrameMetrics;
+use pins::{Pins, read_pins};
+use placement::check_placement;
+use progress::{ClothRun, Progress, read_checkpoint, write_checkpoint};
+pub use settings::{SETTLE_SECONDS, SimulateSettings};
+
+/// What a run simulates: the garment (`.obj`, metres, modelled around the body at rest) and its
+/// pins file, on `model` (called `body`, of shape `betas`) playing `motion` (read from
+/// `motion_path`).
+pub struct SimulateJob<'a> {
+    pub garment: &'a Path,
+    pub pins: Option<&'a Path>,
+    pub model: &'a BodyModel,
+    pub body: &'a str,
+    pub betas: &'a [f32],
+    pub motion: &'a Motion,
+    pub motion_path: &'a Path,
+}
+
+/// A run simulated as far as it went: the motion frames recorded and their metrics, and the
+/// error that stopped it, if one did.
+pub struct Simulation {
+    garment: TriMesh,
+    progress: Progress,
+    phases: PhaseTimes,
+    stopped: Option<SimulateError>,
+    checkpoint: PathBuf,
+}
+
+/// Simulates `job` with `settings`, resuming from the checkpoint in `out` when it holds one of
+/// this run (and `settings.restart` is not set). An error before any motion frame is recorded is
+/// returned as is; one after is kept in the [`Simulation`] with the frames before it.
+pub fn simulate(
+    job: &SimulateJob,
+    settings: &SimulateSettings,
+    out: &Path,
+) -> Result<Simulation, SimulateError> {
+    let garment_path = job.garment;
+    let garment = read_obj(garment_path)?;
+    let pins = match job.pins {
+        Some(p) => read_pins(p, garment.vertex_count())?,
+        None => Pins::default(),
+    };
+    let cloth = Cloth::new(&garment, &settings.material, &pins.fixed)
+        .map_err(|e| SimulateError::from(e).of(garment_path.display().to_string()))?;
+    let (model, motion) = (job.model, job.motion);
+    check_kept_positions(job.motion_path, motion.num_frames(), garment.vertex_count())?;
+    let schedule = Settling::new(model, motion, settings.settle)?;
+    let shaped = shape_body(model, job.betas)?;
+    let faces = model.template_mesh().faces;
+    let body_at = |k: usize| -> Result<Vec<[f32; 3]>, SimulateError> {
+        let (pose, trans) = schedule.pose(k);
+        Ok(points(pose_frames(model, &shaped, pose, trans)?.frame_vertices(0)))
+    };
+    let rest = body_at(0)?;
+    check_placement(garment_path, &garment, &rest)?;
+    let attachments: Vec<Attachment> = pins
+        .attached
+        .iter()
+        .map(|&v| Attachment::bind(&rest, &faces, v, garment.positions[v as usize]))
+        .collect();
+
+    let run = ClothRun {
+        garment: file_hash(garment_path)?,
+        pins: match job.pins {
+            Some(p) => file_hash(p)?,
+            None => "none".into(),
+        },
+        motion: file_hash(job.motion_path)?,
+        body: job.body.to_string(),
+        betas: job.betas.to_vec(),
+        fps: motion.fps,
+        frames: motion.num_frames(),
+        material: settings.material,
+        substeps: settings.substeps,
+        settle: settings.settle,
+        self_collision: settings.self_collision,
+    };
+    let solver =
+        Settings { substeps: settings.substeps, self_collision: run.self_collision, ..Settings::default() };
+    let mut sim = Simulator::new(cloth, Some(Body::new(faces.clone())), attachments, solver)?;
+    let checkpoint = out.join(CHECKPOINT);
+    if settings.restart {
+        std::fs::remove_file(&checkpoint).ok();
+    }
+    let mut progress = Progress::start();
+    if checkpoint.exists() {
+        let (resumed, state) = read_checkpoint(&checkpoint, &run, garment.vertex_count(), &schedule)?;
+        sim.restore(state)?;
+        tracing::info!("resuming {} at frame {} of {}", checkpoint.display(), resumed.next, schedule.len());
+        progress = resumed;
+    }
+
+    let dt = 1.0 / motion.fps;
+    let bar = mannequin_io::progress::bar(schedule.len() as u64, "frames");
+    bar.set_position(progress.next as u64);
+    let mut previous = body_at(progress.next - 1)?;
+    let outcome = (progress.next..schedule.len()).try_for_each(|k| -> Result<(), SimulateError> {
+        let next = body_at(k)?;
+        let start = Instant::now();
+        sim.step_frame(&previous, &next, dt).map_err(|e| {
+            let when = if k < schedule.settle {
+                "while settling".to_string()
+            } else {
+                format!("at motion frame {}", k - schedule.settle)
+            };
+            SimulateError::from(e).of(format!("{} {when} (simulation frame {k})", garment_path.display()))
+        })?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        if k >= schedule.settle {
+            let positions = sim.positions().to_vec();
+            let cloth = (garment.positions.as_slice(), garment.faces.as_slice());
+            let body = (next.as_slice(), faces.as_slice());
+            progress.metrics.push(FrameMetrics::measure(k - schedule.settle, &positions, cloth, body, ms));
+            progress.frames.push(positions);
+        }
+        bar.set_message(format!("{ms:.0} ms/frame"));
+        bar.inc(1);
+        progress.next = k + 1;
+        if settings.checkpoint_every > 0
+            && progress.next.is_multiple_of(settings.checkpoint_every)
+            && progress.next < schedule.len()
+        {
+            write_checkpoint(&checkpoint, &run, &sim.state(), &progress)?;
+        }
+        previous = next;
+        Ok(())
+    });
+    bar.finish_and_clear();
+    let stopped = match outcome {
+        Err(e) if progress.frames.is_empty() => return Err(e),
+        outcome => outcome.err(),
+    };
+    Ok(Simulation { garment, progress, phases: sim.phase_times(), stopped, checkpoint })
+}
+
+impl Simulation {
+    /// garment.pc2, garment.npz, scene.glb and metrics.json for the frames recorded, into `dir`
+    /// (a staging folder the caller moves into `out`).
+    pub fn write(&self, dir: &Path, out: &Path, job: &SimulateJob) -> Result<(), SimulateError> {
+        let body = (job.model, job.betas, job.motion);
+        let frames = &self.progress.frames;
+        let summary =
+            outputs::write_outputs(dir, &self.garment, body, frames, &self.progress.metrics, &self.phases)?;
+        let f = frames.len();
+        tracing::info!(
+            "wrote {}: {f} frames of {} vertices; {:.1} ms per frame; at most {} vertices inside the body, {} self-intersecting pairs",
+            out.display(),
+            self.garment.vertex_count(),
+            summary["ms_per_frame"].as_f64().unwrap_or(0.0),
+            summary["max_vertices_inside_body"],
+            summary["max_self_intersecting_pairs"],
+        );
+        Ok(())
+    }
+
+    /// Ends the run whose outputs are in `out`: a finished one drops its checkpoint; a stopped
+    /// one is its error, saying how many frames were kept.
+    pub fn finish(self, out: &Path) -> Result<(), SimulateError> {
+        match self.stopped {
+            None => {
+                std::fs::remove_file(&self.checkpoint).ok();
+                Ok(())
+            }
+            Some(error) => Err(SimulateError::Kept {
+                error: Box::new(error),
+                frames: self.progress.frames.len(),
+                out: out.display().to_string(),
+            }),
+        }
+    }
+}
