@@ -15,6 +15,7 @@ pub mod ply_header;
 pub mod progress;
 pub mod rng;
 pub mod run_record;
+pub mod video;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use error::{IoError, NpyError, PickleError};
@@ -22,3 +23,4 @@ pub use npy::{NpyArray, NpyData};
 pub use npz::{Npz, NpzWriter};
 pub use ply_body::{PlyValueError, PlyValues};
 pub use ply_header::{PlyHeader, PlyHeaderError};
+pub use video::{VideoError, write_video};

@@ -13,6 +13,7 @@ pub mod kdtree;
 pub mod laplacian;
 pub mod manifold;
 pub mod mass;
+pub mod mesh_file;
 pub mod normals;
 pub mod obj;
 pub mod pc2;
@@ -33,6 +34,7 @@ pub use gltf::{
 pub use gradient::gradient_operator;
 pub use laplacian::cotan_laplacian;
 pub use mass::{MassKind, mass_matrix, vertex_areas};
+pub use mesh_file::{MeshWriteError, write_mesh};
 pub use obj::{Obj, ObjGroup, read_obj, write_obj};
 pub use pc2::PointCache;
 pub use tri_mesh::{MeshError, TriMesh, UvLayout, points};

@@ -1,20 +1,18 @@
 //! `mannequin animate`: render a trained avatar at every frame of a motion to PNGs (and an
 //! `.mp4` where ffmpeg is installed). A skinned `.glb` of a bare body is `mannequin body animate`.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use burn::tensor::Device;
 use clap::Args as ClapArgs;
-use mannequin_avatar::{Avatar, predict};
+use mannequin_avatar::{Avatar, RenderMap, predict};
 use mannequin_body::Motion;
-use mannequin_splat::Camera;
-
-use crate::motion::Clip;
-use crate::render::{Map, box_centre, front_camera, write_map};
-use crate::splat::read_camera;
 use mannequin_io::progress::{JobTimer, bar};
+use mannequin_io::write_video;
+use mannequin_splat::{clip_camera, read_camera};
+
+use crate::shared::Clip;
 
 #[derive(ClapArgs)]
 #[command(
@@ -31,8 +29,8 @@ pub struct Args {
     #[arg(long)]
     camera: Option<PathBuf>,
     /// What to render.
-    #[arg(long, value_enum, default_value_t = Map::Rgb)]
-    what: Map,
+    #[arg(long, value_enum, default_value_t = RenderMap::Rgb)]
+    what: RenderMap,
     /// Output folder of frames.
     #[arg(short, long)]
     output: PathBuf,
@@ -41,25 +39,6 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let motion = args.clip.load()?;
     animate_avatar(&args, &motion)
-}
-
-/// `render`'s front camera on the centre of the clip's bounding box `lo`–`hi`, moved back until
-/// the whole box fits, so the view stays fixed while the body moves through it.
-pub fn clip_camera(lo: [f32; 3], hi: [f32; 3]) -> Camera {
-    /// Room around the box, as a fraction of its half-size.
-    const MARGIN: f64 = 1.1;
-    let centre = box_centre(&[lo, hi]);
-    let camera = front_camera(centre);
-    let c = centre.map(f64::from);
-    let distance = camera.centre()[2] - c[2];
-    let tan_half = 0.5 * camera.width as f64 / camera.intrinsic[0][0];
-    let half = |k: usize| 0.5 * f64::from(hi[k] - lo[k]);
-    let needed = MARGIN * half(0).max(half(1)) / tan_half + half(2);
-    if needed <= distance {
-        return camera;
-    }
-    let eye = [c[0], c[1], c[2] + needed];
-    Camera::look_at(eye, c, [0.0, 1.0, 0.0], 2.0 * tan_half.atan(), camera.width, camera.height)
 }
 
 fn animate_avatar(args: &Args, motion: &Motion) -> Result<()> {
@@ -92,7 +71,7 @@ fn animate_avatar(args: &Args, motion: &Motion) -> Result<()> {
     let progress = bar(frames as u64, "rendering");
     let rendered = (0..frames).try_for_each(|f| {
         let p = predict(&avatar, &camera, pose(f), transl(f))?;
-        write_map(&p, args.what, &frame_path(f))?;
+        p.write_map(args.what, &frame_path(f))?;
         progress.inc(1);
         anyhow::Ok(())
     });
@@ -112,39 +91,5 @@ fn animate_avatar(args: &Args, motion: &Motion) -> Result<()> {
         camera.height,
         args.output.display()
     );
-    write_video(&args.output, &args.output.join("animation.mp4"), frames, motion.fps)
-}
-
-/// Encodes `dir/frame_%04d.png` as `video` (H.264, yuv420p: what players accept) where ffmpeg is
-/// installed, writing to a temporary name and renaming so a failed run leaves no partial video.
-/// Only the `frames` frames of this run are read, not stale ones from a longer earlier run.
-pub fn write_video(dir: &Path, video: &Path, frames: usize, fps: f32) -> Result<()> {
-    let partial = video.with_extension("mp4.partial");
-    let result = Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-framerate", &fps.to_string(), "-i"])
-        .arg(dir.join("frame_%04d.png"))
-        .args(["-frames:v", &frames.to_string()])
-        // yuv420p needs even sides.
-        .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-f", "mp4"])
-        .arg(&partial)
-        .output();
-    let output = match result {
-        Ok(o) => o,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            tracing::info!(
-                "no video written: ffmpeg is not on PATH (the PNG frames are in {})",
-                dir.display()
-            );
-            return Ok(());
-        }
-        Err(e) => return Err(e).with_context(|| format!("running ffmpeg for {}", video.display())),
-    };
-    if !output.status.success() {
-        let _ = std::fs::remove_file(&partial);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        bail!("{}: ffmpeg failed: {}", video.display(), stderr.lines().last().unwrap_or("no message").trim());
-    }
-    std::fs::rename(&partial, video).with_context(|| format!("writing {}", video.display()))?;
-    tracing::info!("wrote {} ({fps} fps)", video.display());
-    Ok(())
+    Ok(write_video(&args.output, &args.output.join("animation.mp4"), frames, motion.fps)?)
 }

@@ -1,17 +1,15 @@
 //! `mannequin body info|pose|animate`: inspect a body model, write a posed body as `.obj` or
 //! `.ply`, or a skinned, animated `.glb` of it playing a motion.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use mannequin_body::{BodyModel, FaceModel, forward, skeletal_animation, skinned_body};
-use mannequin_io::limits::MAX_BETA;
-use mannequin_mesh::TriMesh;
+use mannequin_body::{BodyModel, FaceModel, forward, load_body, skeletal_animation, skinned_body};
+use mannequin_mesh::write_mesh;
 use serde_json::json;
 
-use crate::motion::Clip;
-use crate::pose_choice::PoseChoice;
+use crate::shared::{BodyArgs, Clip, PoseChoice};
 
 #[derive(Subcommand)]
 pub enum BodyCommand {
@@ -21,28 +19,6 @@ pub enum BodyCommand {
     Pose(PoseArgs),
     /// Drive a body with a motion and write a skinned, animated glTF binary (`.glb`).
     Animate(AnimateArgs),
-}
-
-/// The body model and its shape, shared by the body verbs.
-#[derive(Args)]
-pub struct BodyArgs {
-    /// Body model: `default`, `default-lod1`, or a SMPL / SMPL-H / SMPL-X `.npz` or released `.pkl`.
-    #[arg(long, default_value = "default")]
-    pub body: String,
-    /// Shape coefficients, comma-separated (missing ones are 0), each within ±10.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = parse_beta)]
-    pub betas: Vec<f32>,
-}
-
-/// One shape coefficient: finite and within [`MAX_BETA`] standard deviations, refused at parse
-/// time (`--betas 1e6` once grew a garment to 5 GB).
-fn parse_beta(text: &str) -> Result<f32, String> {
-    let b: f32 = text.parse().map_err(|e| format!("{e}"))?;
-    if f64::from(b.abs()) <= MAX_BETA {
-        Ok(b)
-    } else {
-        Err(format!("{b}: expected a finite shape coefficient within ±{MAX_BETA}"))
-    }
 }
 
 #[derive(Args)]
@@ -86,10 +62,6 @@ pub fn run(cmd: BodyCommand) -> Result<()> {
         BodyCommand::Pose(args) => pose(args),
         BodyCommand::Animate(args) => animate(args),
     }
-}
-
-pub fn load_body(spec: &str) -> Result<BodyModel> {
-    BodyModel::from_spec(spec, None).with_context(|| format!("loading body model '{spec}'"))
 }
 
 /// The facts `body info` reports, as JSON (the table prints the same values).
@@ -213,15 +185,5 @@ fn animate(args: AnimateArgs) -> Result<()> {
         model.num_vertices(),
         model.num_joints()
     );
-    Ok(())
-}
-
-/// Writes `.obj` or `.ply` by extension, atomically.
-pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
-        Some("obj") => mannequin_mesh::obj::write_obj(path, mesh)?,
-        Some("ply") => mannequin_mesh::ply::write(path, mesh, None)?,
-        _ => bail!("{}: unknown mesh format; expected a .obj or .ply extension", path.display()),
-    }
     Ok(())
 }

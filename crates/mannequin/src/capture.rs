@@ -21,7 +21,7 @@ use mannequin_fit::pose_landmarker::{NUM_LANDMARKS, PoseLandmarks};
 use mannequin_fit::{BodyFit, PersonModels};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
-use crate::body::load_body;
+use mannequin_body::load_body;
 use crate::checkpoint::{CHECKPOINT, add_run, check_run};
 use crate::fit::{FitArgs, check_picture, posed_mesh};
 use crate::video_input::{Frames, VideoArgs};

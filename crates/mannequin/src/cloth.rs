@@ -18,11 +18,12 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::{MorphSequence, PointCache, TriMesh, points, read_obj, write_scene_glb};
 use serde::Serialize;
 
-use crate::body::{BodyArgs, load_body};
+use crate::shared::BodyArgs;
+use mannequin_body::load_body;
 use crate::checkpoint::{
     CHECKPOINT, add_run, add_state, check_run, file_hash, frames_array, read_frames, read_state,
 };
-use crate::motion::Clip;
+use crate::shared::Clip;
 use crate::sim_limits::{MAX_SUBSTEPS, check_kept_positions, parse_settle};
 use crate::staging::Staging;
 use mannequin_io::progress::{JobTimer, bar};

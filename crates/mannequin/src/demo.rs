@@ -1,13 +1,13 @@
 //! `mannequin demo`: the README's main job on the embedded default body. It makes a synthetic
 //! clothed subject, trains a Tavatar avatar on it, evaluates it on novel views and poses,
 //! animates it with a walk, and exports it (skinned .glb, 3DGS .ply, posed .obj), all under one
-//! folder. Each stage runs the same code as its own verb; one progress bar at a time shows the
-//! stage it belongs to.
+//! folder. Each stage runs the same code as its own verb (through the command line the binary
+//! hands in); one progress bar at a time shows the stage it belongs to.
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use clap::{Args as ClapArgs, Parser};
+use clap::Args as ClapArgs;
 
 use mannequin_io::progress::{JobTimer, set_stage};
 
@@ -30,7 +30,8 @@ pub struct Args {
     walk_frames: usize,
 }
 
-pub fn run(args: Args) -> Result<()> {
+/// Runs the stages, each through `run_verb` (a verb's command line, without the binary's name).
+pub fn run(args: Args, run_verb: impl Fn(&[&str]) -> Result<()>) -> Result<()> {
     let _timer = JobTimer::start("demo");
     let path = |p: &str| args.out.join(p).to_string_lossy().into_owned();
     let (seed, iters, size, frames) =
@@ -67,9 +68,7 @@ pub fn run(args: Args) -> Result<()> {
     let count = stages.len();
     for (i, (name, argv)) in stages.into_iter().enumerate() {
         set_stage(&format!("{}/{count} {name}", i + 1));
-        let cli = crate::Cli::try_parse_from(std::iter::once("mannequin").chain(argv))
-            .with_context(|| format!("demo stage {name}"))?;
-        crate::dispatch(cli.command).with_context(|| format!("demo stage {name}"))?;
+        run_verb(&argv).with_context(|| format!("demo stage {name}"))?;
     }
     set_stage("");
     tracing::info!(

@@ -8,13 +8,12 @@ use anyhow::{Context, Result, anyhow, bail};
 use burn::tensor::Device;
 use mannequin_avatar::params::host_rows;
 use mannequin_avatar::{Avatar, Posed, export};
-use mannequin_body::{Motion, skeletal_animation};
-use mannequin_mesh::TriMesh;
-use mannequin_mesh::gltf::{SkeletalAnimation, scene_glb_bytes};
-
-use crate::body::write_mesh;
-use crate::pose_choice::PoseChoice;
+use mannequin_body::Motion;
 use mannequin_io::progress::JobTimer;
+use mannequin_mesh::gltf::scene_glb_bytes;
+use mannequin_mesh::{TriMesh, write_mesh};
+
+use crate::shared::PoseChoice;
 
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("outputs").required(true).multiple(true).args(["output", "gaussians", "skinned_gaussians"]))]
@@ -74,7 +73,7 @@ fn mesh_files(
 ) -> Result<Vec<(PathBuf, Made)>> {
     if let Some(motion) = glb {
         let (body, layers) = export::skinned_layers(avatar, posed)?;
-        let animation = motion.map(|m| avatar_animation(avatar, m)).transpose()?;
+        let animation = motion.map(|m| avatar.animation(m)).transpose()?;
         let bytes = scene_glb_bytes(output, &body, &layers, animation.as_ref(), &[])?;
         return Ok(vec![(output.to_path_buf(), Made::Bytes(bytes))]);
     }
@@ -96,18 +95,6 @@ fn layer_path(output: &Path, layer: &str) -> PathBuf {
     let stem = output.file_stem().map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
     let extension = output.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
     output.with_file_name(format!("{stem}.{layer}{extension}"))
-}
-
-/// `motion` as an animation of the avatar's glTF skeleton ([`export::skinned_mesh`]).
-pub fn avatar_animation(avatar: &Avatar, motion: &Motion) -> Result<SkeletalAnimation> {
-    let j = avatar.canonical.num_joints();
-    let poses = motion.poses_for_joints(j)?;
-    Ok(skeletal_animation(j, &poses, &motion.trans, motion.fps)?)
-}
-
-/// The avatar at its canonical pose (zero rotations, no translation): the glTF bind pose.
-pub fn canonical_pose(avatar: &Avatar) -> Result<Posed> {
-    Ok(avatar.pose(&vec![0.0; 3 * avatar.canonical.num_joints()], [0.0; 3])?)
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -144,7 +131,7 @@ pub fn run(args: Args) -> Result<()> {
         files.push((path.clone(), Made::Bytes(scene.ply_bytes(&[]).with_context(|| writing(path))?)));
     }
     if let Some(path) = &args.skinned_gaussians {
-        let bytes = export::skinned_gaussians_ply(&avatar, &canonical_pose(&avatar)?)
+        let bytes = export::skinned_gaussians_ply(&avatar, &avatar.canonical_pose()?)
             .with_context(|| writing(path))?;
         files.push((path.clone(), Made::Bytes(bytes)));
     }

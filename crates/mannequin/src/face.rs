@@ -80,7 +80,7 @@ fn fit(args: FaceFitArgs) -> Result<()> {
         .with_context(|| format!("fitting the face in {}", args.image.display()))?;
     let (head, texture) = head_mesh(&body, &face_model, &[(&fitted, &image)])?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    crate::body::write_mesh(&args.out.join("face.obj"), &head)?;
+    mannequin_mesh::write_mesh(&args.out.join("face.obj"), &head)?;
     let shapes = expression_shapes(&face_model, &head, &fitted.expression);
     write_blend_shape_glb(args.out.join("face.glb"), &shapes, None)?;
     let picture =

@@ -23,7 +23,7 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::{BlendShapeAnimation, write_blend_shape_glb};
 use rayon::prelude::*;
 
-use crate::animate::write_video;
+use mannequin_io::write_video;
 use crate::checkpoint::{CHECKPOINT, add_run, check_run};
 use crate::face::{MIN_FACE_PX, check_face_body, expression_shapes, fitted_head, head_mesh, projected_edges};
 use crate::fit::FitArgs;

@@ -21,7 +21,7 @@ use mannequin_io::limits::FOCAL_RANGE_PER_SIDE;
 use mannequin_io::{NpyArray, NpzWriter};
 use mannequin_mesh::TriMesh;
 
-use crate::body::load_body;
+use mannequin_body::load_body;
 use crate::face::MIN_FACE_PX;
 
 /// The detector reads a 224² letterbox: smaller pictures hold too little to find a body in.
@@ -118,7 +118,7 @@ pub fn run(args: Args) -> Result<()> {
     let mesh = posed_mesh(&model, &fit)?;
     let (picture, iou) = check_picture(&image, &mesh, &landmarks, &fit);
     write_body_npz(&args.out.join("body.npz"), &fit, &head)?;
-    crate::body::write_mesh(&args.out.join("body.obj"), &mesh)?;
+    mannequin_mesh::write_mesh(&args.out.join("body.obj"), &mesh)?;
     write_glb(&args.out.join("body.glb"), &model, &fit)?;
     picture.write_png(&args.out.join("overlay.png"))?;
     let mut report = report(&fit, person, iou, focal, start.elapsed().as_secs_f64());

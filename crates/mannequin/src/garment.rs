@@ -11,7 +11,8 @@ use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::{CATEGORY_NAMES, Category, Ease, Garment, SIZE_NAMES, make_garment};
 use mannequin_mesh::write_obj;
 
-use crate::body::{BodyArgs, load_body};
+use crate::shared::BodyArgs;
+use mannequin_body::load_body;
 
 #[derive(Subcommand)]
 pub enum GarmentCommand {

@@ -18,7 +18,7 @@ use mannequin_garment::ngd::{
 use mannequin_garment::{Category, Dressed};
 use mannequin_mesh::{MorphSequence, TriMesh};
 
-use crate::body::load_body;
+use mannequin_body::load_body;
 use mannequin_garment::{load_or_make, write_layered_scene};
 use mannequin_io::progress::{JobTimer, bar};
 
@@ -228,7 +228,7 @@ pub fn reconstruct(
     // The template's UVs hold while the topology is the template's.
     let uv = garment.mesh.uv.clone().filter(|_| fit.faces().len() == garment.mesh.faces.len());
     let mesh = TriMesh { positions: fit.rest(), faces: fit.faces().to_vec(), uv, colors: None };
-    crate::body::write_mesh(&out.join("garment.obj"), &mesh)?;
+    mannequin_mesh::write_mesh(&out.join("garment.obj"), &mesh)?;
     let report = serde_json::json!({
         "category": category,
         "label": label_name,

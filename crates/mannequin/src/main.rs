@@ -18,8 +18,8 @@ mod garment_fit;
 mod garment_layers;
 mod logging;
 mod motion;
-mod pose_choice;
 mod render;
+mod shared;
 mod sim_limits;
 mod splat;
 mod staging;
@@ -92,7 +92,7 @@ enum Command {
     View(view::Args),
 }
 
-/// Runs one verb; the demo chains several through here.
+/// Runs one verb.
 fn dispatch(command: Command) -> anyhow::Result<()> {
     match command {
         Command::Body(cmd) => body::run(cmd),
@@ -105,7 +105,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Face(cmd) => face::run(cmd),
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
-        Command::Demo(args) => demo::run(args),
+        Command::Demo(args) => demo::run(args, run_verb),
         Command::Eval(args) => eval::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Splat(args) => splat::run(args),
@@ -113,6 +113,13 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
     }
+}
+
+/// Parses and runs one verb's command line (without the binary's name): the demo chains several
+/// through here.
+fn run_verb(argv: &[&str]) -> anyhow::Result<()> {
+    let cli = Cli::try_parse_from(std::iter::once("mannequin").chain(argv.iter().copied()))?;
+    dispatch(cli.command)
 }
 
 fn main() -> std::process::ExitCode {

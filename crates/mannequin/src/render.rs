@@ -2,30 +2,16 @@
 //! file or in a named pose, through the frame's camera, a camera JSON, or a front view; as
 //! colour, normals, alpha or depth.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use burn::tensor::Device;
-use mannequin_avatar::{Avatar, frame_camera, predict};
-use mannequin_data::{Dataset, Image};
-use mannequin_splat::Camera;
-
-use crate::pose_choice::PoseChoice;
-use crate::splat::read_camera;
+use mannequin_avatar::{Avatar, RenderMap, frame_camera, predict};
+use mannequin_data::Dataset;
 use mannequin_io::progress::JobTimer;
+use mannequin_splat::{Camera, box_centre, front_camera, read_camera};
 
-/// What a render writes.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum Map {
-    /// Colour.
-    Rgb,
-    /// Camera-space normals.
-    Normals,
-    /// Coverage, white on black.
-    Alpha,
-    /// Depth, near bright (or metric values in a `.npy` output).
-    Depth,
-}
+use crate::shared::PoseChoice;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -46,30 +32,11 @@ pub struct Args {
     #[arg(long)]
     camera: Option<PathBuf>,
     /// What to render.
-    #[arg(long, value_enum, default_value_t = Map::Rgb)]
-    what: Map,
+    #[arg(long, value_enum, default_value_t = RenderMap::Rgb)]
+    what: RenderMap,
     /// Output .png (depth: also .npy for metric values).
     #[arg(short, long)]
     output: PathBuf,
-}
-
-/// A 540×540 camera 3.2 m in front of the (posed) body's centre, looking along −Z.
-pub fn front_camera(centre: [f32; 3]) -> Camera {
-    let c = centre.map(f64::from);
-    Camera::look_at([c[0], c[1], c[2] + 3.2], c, [0.0, 1.0, 0.0], 0.65, 540, 540)
-}
-
-/// Centre of a mesh's bounding box.
-pub fn box_centre(positions: &[[f32; 3]]) -> [f32; 3] {
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]))
 }
 
 /// Pose, translation and camera of the requested frame.
@@ -93,42 +60,12 @@ fn frame_inputs(args: &Args, avatar: &Avatar) -> Result<(Vec<f32>, [f32; 3], Cam
     Ok((pose, transl, camera))
 }
 
-/// Writes the requested map of a prediction.
-pub fn write_map(p: &mannequin_avatar::Prediction, what: Map, output: &Path) -> Result<()> {
-    let grey = |values: &[f32]| Image {
-        width: p.image.width,
-        height: p.image.height,
-        pixels: values.iter().map(|&v| [v; 3]).collect(),
-    };
-    match what {
-        Map::Rgb => p.image.write_png(output)?,
-        Map::Normals => p.normals.write_png(output)?,
-        Map::Alpha => grey(&p.mask.values.iter().map(|&m| f32::from(u8::from(m))).collect::<Vec<_>>())
-            .write_png(output)?,
-        Map::Depth if output.extension().is_some_and(|e| e == "npy") => p.depth.write_npy(output)?,
-        Map::Depth => {
-            let fg = p.depth.depth.iter().filter(|&&d| d > 0.0);
-            let (lo, hi) = fg.fold((f32::INFINITY, 0.0f32), |(lo, hi), &d| (lo.min(d), hi.max(d)));
-            let span = (hi - lo).max(1e-6);
-            // Near is bright, the background black.
-            let v: Vec<f32> = p
-                .depth
-                .depth
-                .iter()
-                .map(|&d| if d > 0.0 { 1.0 - 0.8 * (d - lo) / span } else { 0.0 })
-                .collect();
-            grey(&v).write_png(output)?
-        }
-    }
-    Ok(())
-}
-
 pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("render");
     let avatar = Avatar::load(&args.avatar, &Device::flex())?;
     let (pose, transl, camera) = frame_inputs(&args, &avatar)?;
     let p = predict(&avatar, &camera, &pose, transl)?;
-    write_map(&p, args.what, &args.output)?;
+    p.write_map(args.what, &args.output)?;
     tracing::info!("wrote {}", args.output.display());
     Ok(())
 }

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use mannequin_splat::{Camera, RenderOptions, SplatScene, render};
+use mannequin_splat::{RenderOptions, SplatScene, read_camera, render};
 use serde_json::{Value, json};
 
 use mannequin_io::progress::JobTimer;
@@ -50,12 +50,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Verb::Render { ply, camera, output, dilation } => render_to_png(&ply, &camera, &output, dilation),
         Verb::Info { file, json } => info(&file, json),
     }
-}
-
-/// A camera JSON file, with its background colour.
-pub fn read_camera(path: &Path) -> anyhow::Result<(Camera, Vec<f64>)> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
-    Ok(mannequin_splat::parse_camera_json(path, &bytes)?)
 }
 
 fn render_to_png(ply: &Path, camera: &Path, output: &Path, dilation: f64) -> anyhow::Result<()> {

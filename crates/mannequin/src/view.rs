@@ -6,7 +6,6 @@ mod site;
 
 use std::net::TcpListener;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use anyhow::{Context, Result};
 
@@ -41,7 +40,7 @@ pub fn run(args: Args) -> Result<()> {
     if args.open {
         open_browser(&url);
     }
-    http::serve(listener, Arc::new(site));
+    http::serve(listener, move |path| site.get(path));
     Ok(())
 }
 

@@ -11,7 +11,8 @@ use mannequin_mesh::normals::vertex_normals;
 use mannequin_splat::Camera;
 use rayon::prelude::*;
 
-use crate::animate::{clip_camera, write_video};
+use mannequin_io::write_video;
+use mannequin_splat::clip_camera;
 use mannequin_io::progress::bar;
 
 /// Skin's colour, linear RGB.
@@ -91,7 +92,7 @@ pub fn render(
         Ok(())
     })?;
     progress.finish_and_clear();
-    write_video(&folder, &dir.join("frames.mp4"), body.len(), fps)
+    Ok(write_video(&folder, &dir.join("frames.mp4"), body.len(), fps)?)
 }
 
 #[cfg(test)]

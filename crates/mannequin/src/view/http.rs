@@ -1,14 +1,13 @@
-//! A read-only HTTP/1.1 server for the viewer, on loopback only: GET and HEAD of the embedded
-//! page, the scene's generated files and the files under the viewed folder, nothing else. One
-//! request per connection; a request head is at most [`MAX_HEAD`] bytes and carries no body.
+//! A read-only HTTP/1.1 server for the viewer, on loopback only: GET and HEAD of what the site
+//! answers for a path (the embedded page, the scene's generated files and the files under the
+//! viewed folder), nothing else. One request per connection; a request head is at most
+//! [`MAX_HEAD`] bytes and carries no body.
 
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Component, Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
-
-use super::site::Site;
 
 /// The largest request head read; a browser's GET is well under 2 KiB.
 pub const MAX_HEAD: usize = 8 * 1024;
@@ -39,26 +38,28 @@ fn reason(status: u16) -> &'static str {
     }
 }
 
-/// Serves `site` on `listener` until the process ends, a thread per connection.
-pub fn serve(listener: TcpListener, site: Arc<Site>) {
+/// Serves `get`'s response to each GET of a path (the URL's path, still %-encoded) on `listener`
+/// until the process ends, a thread per connection.
+pub fn serve(listener: TcpListener, get: impl Fn(&str) -> Response + Send + Sync + 'static) {
     let port = listener.local_addr().map(|a| a.port()).unwrap_or(0);
+    let get = Arc::new(get);
     for stream in listener.incoming().flatten() {
-        let site = Arc::clone(&site);
+        let get = Arc::clone(&get);
         std::thread::spawn(move || {
-            if let Err(e) = handle(stream, &site, port) {
+            if let Err(e) = handle(stream, &*get, port) {
                 tracing::debug!("connection: {e}");
             }
         });
     }
 }
 
-fn handle(mut stream: TcpStream, site: &Site, port: u16) -> std::io::Result<()> {
+fn handle(mut stream: TcpStream, get: &dyn Fn(&str) -> Response, port: u16) -> std::io::Result<()> {
     stream.set_read_timeout(Some(Duration::from_secs(10)))?;
     stream.set_write_timeout(Some(Duration::from_secs(60)))?;
     let (response, head_only) = match read_head(&mut stream)? {
         Some(head) => {
             let head_only = head.starts_with("HEAD ");
-            (respond(&head, site, port), head_only)
+            (respond(&head, get, port), head_only)
         }
         None => (Response::text(431, "the request head is over 8 KiB"), false),
     };
@@ -95,7 +96,7 @@ fn read_head(stream: &mut TcpStream) -> std::io::Result<Option<String>> {
 }
 
 /// The response to one request head.
-pub fn respond(head: &str, site: &Site, port: u16) -> Response {
+fn respond(head: &str, get: &dyn Fn(&str) -> Response, port: u16) -> Response {
     let mut lines = head.split("\r\n");
     let request = lines.next().unwrap_or_default();
     let mut parts = request.split(' ');
@@ -128,7 +129,7 @@ pub fn respond(head: &str, site: &Site, port: u16) -> Response {
         return Response::text(403, "only requests to 127.0.0.1 or localhost are served");
     }
     let path = target.split(['?', '#']).next().unwrap_or_default();
-    site.get(path)
+    get(path)
 }
 
 /// The file under `root` that a URL path (after `/files/`) names, or why it is refused: the path

@@ -15,7 +15,6 @@ use mannequin_splat::SplatScene;
 use serde_json::{Value, json};
 
 use super::http::{Response, content_type, resolve};
-use crate::export::{avatar_animation, canonical_pose};
 
 const INDEX: &[u8] = include_bytes!("../../viewer/src/index.html");
 const VIEWER: &[u8] = include_bytes!("../../viewer/dist/viewer.js");
@@ -111,7 +110,7 @@ impl Site {
         layers: &mut Vec<Layer>,
     ) -> Result<Value> {
         let avatar = Avatar::load(dir, &Device::flex())?;
-        let canonical = canonical_pose(&avatar)?;
+        let canonical = avatar.canonical_pose()?;
         let mut named: Vec<(String, Motion)> = Vec::new();
         for p in motions {
             named.push((stem(p), Motion::read(p)?));
@@ -133,7 +132,7 @@ impl Site {
         let (body, garments) = export::skinned_layers(&avatar, &canonical)?;
         let mut offered = Vec::new();
         for (k, (name, motion)) in named.iter().enumerate() {
-            let animation = avatar_animation(&avatar, motion)?;
+            let animation = avatar.animation(motion)?;
             let glb =
                 scene_glb_bytes(&dir.join(format!("{name}.glb")), &body, &garments, Some(&animation), &[])?;
             self.generated.insert(format!("motion_{k}.glb"), ("model/gltf-binary", glb));
