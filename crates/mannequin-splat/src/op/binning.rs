@@ -25,7 +25,7 @@ use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
 use super::SplatConfig;
-use super::cube::{buffer, read, u32_of, units_dim, units_grid, zeros};
+use super::device_buffers::{buffer, read, u32_of, units_dim, units_grid, zeros};
 use super::radix_sort::sort_pairs;
 use super::scan::exclusive_scan;
 use crate::composite::field;
@@ -377,8 +377,9 @@ pub(super) fn bin(
 
 #[cfg(test)]
 mod tests {
-    use super::super::cube::testing::{device, floats, read_words};
-    use super::super::cube::{project, read};
+    use super::super::cube::project;
+    use super::super::device_buffers::read;
+    use super::super::device_buffers::testing::{device, floats, read_words};
     use super::*;
     use crate::project::Projection;
     use crate::{Camera, RenderOptions, tiles};

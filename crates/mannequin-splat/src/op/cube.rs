@@ -8,11 +8,12 @@ use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
-use burn::tensor::{FloatDType, TensorData, read_sync};
+
 use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
 use burn_cubecl::kernel::into_contiguous;
 
 use super::binning::bin;
+use super::device_buffers::{read, u32_of, units_dim, units_grid, upload, zeros};
 use super::kernels::{LayoutLaunch, composite_backward, composite_forward};
 use super::project_kernels::{camera_words, project_backward, project_forward};
 use super::saved::{HEADER, WordLayout, size_words};
@@ -20,30 +21,6 @@ use super::{SplatBackend, SplatConfig};
 use crate::camera::CameraParams;
 use crate::composite::field;
 use crate::composite_vjp::SCREEN_GRADS;
-
-/// Units per cube for the per-Gaussian (and per-chunk) kernels.
-const GROUP: u32 = 256;
-
-pub(super) fn read(t: FloatTensor<CubeBackend>) -> Vec<f32> {
-    read_sync(CubeBackend::float_into_data(t))
-        .expect("reading a splat tensor from the device")
-        .try_to_vec::<f32>()
-        .expect("f32 tensor")
-}
-
-pub(super) fn upload(v: Vec<f32>, like: &CubeTensor) -> CubeTensor {
-    let n = v.len();
-    CubeBackend::float_from_data(TensorData::new(v, vec![n]), &like.device())
-}
-
-pub(super) fn zeros(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
-    CubeBackend::float_zeros(shape.into(), &like.device(), FloatDType::F32)
-}
-
-/// A buffer of `len` 32-bit words that a kernel fills (kernels read `f32` buffers as `u32` too).
-pub(super) fn buffer(len: usize, like: &CubeTensor) -> CubeTensor {
-    CubeBackend::float_empty(vec![len].into(), &like.device(), FloatDType::F32)
-}
 
 /// Alpha threshold, cap, transmittance floor and background, as the compositing kernels read them.
 fn params(config: &SplatConfig, like: &CubeTensor) -> CubeTensor {
@@ -55,10 +32,6 @@ fn params(config: &SplatConfig, like: &CubeTensor) -> CubeTensor {
 
 fn camera(config: &SplatConfig, like: &CubeTensor) -> CubeTensor {
     upload(camera_words(&CameraParams::new(&config.camera), &config.options), like)
-}
-
-pub(super) fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("splat buffers index within u32")
 }
 
 fn launch_layout(l: &WordLayout, config: &SplatConfig) -> LayoutLaunch {
@@ -77,15 +50,6 @@ fn launch_layout(l: &WordLayout, config: &SplatConfig) -> LayoutLaunch {
 fn tile_grid(config: &SplatConfig) -> CubeCount {
     let (tx, ty) = config.camera.tiles();
     CubeCount::Static(tx as u32, ty as u32, 1)
-}
-
-/// Enough cubes of [`units_dim`] for `n` units.
-pub(super) fn units_grid(n: usize) -> CubeCount {
-    CubeCount::Static(u32_of(n).div_ceil(GROUP).max(1), 1, 1)
-}
-
-pub(super) fn units_dim() -> CubeDim {
-    CubeDim::new_1d(GROUP)
 }
 
 /// The projected Gaussians: packed rows (index order, `stride` words each), radii (0: not drawn;
@@ -225,36 +189,5 @@ impl SplatBackend for CubeBackend {
         }
         let [a, b, s, o, col] = d;
         (a, b, s, o, col)
-    }
-}
-
-/// Device buffers for the kernels' unit tests, on [`crate::gpu_device`].
-#[cfg(test)]
-pub(super) mod testing {
-    use burn::backend::DispatchDevice;
-    use burn::backend::ops::FloatTensorOps;
-    use burn::backend::wgpu::{CubeBackend, CubeTensor};
-    use burn::tensor::TensorData;
-    use burn_cubecl::CubeDevice;
-
-    /// The kernels' device, or a panic whose message is [`crate::GpuUnavailable`]'s one line.
-    pub fn device() -> CubeDevice {
-        match crate::gpu_device().unwrap_or_else(|e| panic!("{e}")).as_dispatch() {
-            DispatchDevice::Cube(device) => device.clone(),
-            other => unreachable!("gpu_device gives a wgpu device, not {other:?}"),
-        }
-    }
-
-    pub fn floats(v: &[f32], shape: Vec<usize>, device: &CubeDevice) -> CubeTensor {
-        CubeBackend::float_from_data(TensorData::new(v.to_vec(), shape), device)
-    }
-
-    /// `u32`s travel as the bit patterns of `f32`s, as the kernels read them.
-    pub fn words(v: &[u32], device: &CubeDevice) -> CubeTensor {
-        floats(&v.iter().map(|&x| f32::from_bits(x)).collect::<Vec<_>>(), vec![v.len()], device)
-    }
-
-    pub fn read_words(t: CubeTensor, len: usize) -> Vec<u32> {
-        super::read(t).iter().take(len).map(|v| v.to_bits()).collect()
     }
 }

@@ -5,7 +5,8 @@ use burn::backend::flex::FlexTensor;
 use burn::backend::tensor::FloatTensor;
 use burn::tensor::TensorData;
 
-use super::host::{self, Inputs};
+use super::config::Inputs;
+use super::host;
 use super::{SplatBackend, SplatConfig};
 
 /// Contiguous `f32` views of Flex tensors (converting only when a tensor is strided).

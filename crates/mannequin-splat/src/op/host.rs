@@ -1,18 +1,9 @@
 //! The splatting op on host memory: what the Flex backend runs directly (on its tensors' own
 //! buffers), in terms of the CPU renderer.
 
-use super::SplatConfig;
+use super::config::{Inputs, SplatConfig};
 use super::saved;
 use crate::render::{OutputGrads, backward_checked, render_checked};
-
-/// The five differentiable inputs, flattened row-major.
-pub(crate) struct Inputs<'a> {
-    pub means: &'a [f32],
-    pub rotations: &'a [f32],
-    pub scales: &'a [f32],
-    pub opacities: &'a [f32],
-    pub colors: &'a [f32],
-}
 
 /// Renders; returns `[C + 2, H, W]` (colour, alpha, expected depth) and the saved state.
 pub(crate) fn forward(x: &Inputs, cfg: &SplatConfig) -> (Vec<f32>, Vec<f32>) {

@@ -23,7 +23,9 @@
 
 mod autodiff;
 mod binning;
+mod config;
 mod cube;
+mod device_buffers;
 mod flex;
 mod host;
 mod kernels;
@@ -32,11 +34,12 @@ mod radix_sort;
 mod saved;
 mod scan;
 
+pub use config::SplatConfig;
+
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
 use burn::tensor::Tensor;
 
-use crate::gaussians::{Colors, Gaussians, Rotations};
 use crate::{Camera, RenderOptions, SplatError, sh};
 
 /// Orientation of each Gaussian, as a tensor.
@@ -66,43 +69,6 @@ pub struct SplatImages {
     /// `[1]`: how many Gaussians were skipped for a NaN or infinite parameter (a whole number,
     /// exact up to 2²⁴). It stays on the device until read, so it costs nothing unless asked for.
     pub skipped: Tensor<1>,
-}
-
-/// How the op reads its flat inputs: the camera, the rules, and the input forms. Host data, not
-/// differentiated.
-#[derive(Clone, Debug)]
-pub struct SplatConfig {
-    pub camera: Camera,
-    pub options: RenderOptions,
-    /// Quaternions (4 values per Gaussian) or matrices (9).
-    pub matrices: bool,
-    /// SH degree, or `None` for features.
-    pub sh_degree: Option<usize>,
-    /// Values per Gaussian in the colour input.
-    pub color_len: usize,
-}
-
-impl SplatConfig {
-    pub(crate) fn gaussians<'a>(&self, x: &host::Inputs<'a>) -> Gaussians<'a, f32> {
-        Gaussians {
-            means: x.means,
-            rotations: if self.matrices {
-                Rotations::Matrices(x.rotations)
-            } else {
-                Rotations::Quaternions(x.rotations)
-            },
-            scales: x.scales,
-            opacities: x.opacities,
-            colors: match self.sh_degree {
-                Some(degree) => Colors::Sh { degree, coeffs: x.colors },
-                None => Colors::Features { channels: self.color_len, values: x.colors },
-            },
-        }
-    }
-
-    fn channels(&self) -> usize {
-        if self.sh_degree.is_some() { 3 } else { self.color_len }
-    }
 }
 
 /// Backends that can splat. Inputs are flat `[N, k]` float tensors (means, rotations, scales,
@@ -223,13 +189,4 @@ pub fn splat_render(
         depth: rendered.narrow(0, ch + 1, 1).reshape([h, w]),
         skipped: Tensor::<1>::from_dispatch(saved).narrow(0, saved::SKIPPED, 1),
     })
-}
-
-impl SplatConfig {
-    fn options_checked(&self) -> Result<(), SplatError> {
-        // Validate the options against a zero-Gaussian input of the right form.
-        let x = host::Inputs { means: &[], rotations: &[], scales: &[], opacities: &[], colors: &[] };
-        let g = self.gaussians(&x);
-        crate::render::validate(&g, &self.camera, &self.options, false)
-    }
 }

@@ -11,7 +11,7 @@ use burn::backend::wgpu::CubeTensor;
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
-use super::cube::{buffer, u32_of, units_dim, units_grid};
+use super::device_buffers::{buffer, u32_of, units_dim, units_grid};
 use super::scan::exclusive_scan;
 
 /// Bits sorted per pass, and the digit values.
@@ -124,7 +124,7 @@ pub(super) fn sort_pairs(
 
 #[cfg(test)]
 mod tests {
-    use super::super::cube::testing::{device, read_words, words};
+    use super::super::device_buffers::testing::{device, read_words, words};
     use super::*;
 
     /// Few distinct keys (many ties, so stability shows), spread over every digit, on more pairs

@@ -9,7 +9,7 @@ use burn::backend::wgpu::CubeTensor;
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
-use super::cube::{buffer, u32_of, units_dim, units_grid, zeros};
+use super::device_buffers::{buffer, u32_of, units_dim, units_grid, zeros};
 
 /// Values one unit scans.
 const CHUNK: u32 = 64;
@@ -81,7 +81,7 @@ pub(super) fn exclusive_scan(values: &CubeTensor, len: usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::cube::testing::{device, read_words, words};
+    use super::super::device_buffers::testing::{device, read_words, words};
     use super::*;
 
     /// Lengths around the chunk sizes, and one past lavapipe's loop limit.
