@@ -41,12 +41,28 @@ fn reference(path: &mut Vec<String>, out: &mut String) {
     }
 }
 
+/// The page's opening: how it is made, and what each shared flag means on every verb.
+const CONVENTIONS: &str = "# Command reference
+
+Every `mannequin` command and flag, as `--help` prints them. Generated from the clap definitions
+by `crates/mannequin/tests/cli_reference.rs`; regenerate with
+`MANNEQUIN_BLESS=1 cargo test --release -p mannequin --test cli_reference`.
+
+Each word means one thing on every verb:
+
+- `--body B` is a body model: `default` (the embedded body, about 13k vertices), `default-lod1`
+  (about 1k vertices), or a SMPL / SMPL-H / SMPL-X `.npz` or released `.pkl`;
+- `--avatar DIR` is a trained avatar folder (what `train --out` writes);
+- `--motion FILE --frame N` is frame N of an AMASS or PeopleSnapshot motion, and
+  `--named-pose NAME` a built-in SMPL pose; neither is the rest pose;
+- enumerated flags list their choices and fail at once on a typo.
+
+Results (tables, JSON) go to stdout; logs and progress bars to stderr. A refusal is one line
+naming the file or flag, the field and what was expected (`docs/limits.md`).
+";
+
 fn generated() -> String {
-    let mut out = String::from(
-        "# Command reference\n\nEvery `mannequin` command and flag, as `--help` prints them. Generated from the clap \
-         definitions by `crates/mannequin/tests/cli_reference.rs`; regenerate with\n\
-         `MANNEQUIN_BLESS=1 cargo test --release -p mannequin --test cli_reference`.\n",
-    );
+    let mut out = String::from(CONVENTIONS);
     reference(&mut Vec::new(), &mut out);
     out
 }
