@@ -27,7 +27,8 @@ impl Ease {
         let step = SIZE_NAMES
             .iter()
             .position(|&n| n.eq_ignore_ascii_case(name))
-            .ok_or_else(|| GarmentError::UnknownSize { name: name.to_string(), known: &SIZE_NAMES })? as f32;
+            .ok_or_else(|| GarmentError::UnknownSize { name: name.to_string(), known: &SIZE_NAMES })?
+            as f32;
         Ok(Ease {
             ease_chest: 0.005 + 0.01 * step,
             ease_waist: 0.004 + 0.008 * step,

@@ -1,5 +1,6 @@
 //! `mannequin garment make`: a garment template cut from a body's surface, remeshed and eased
-//! (thesis §3.2), written as a `.garment` file; `garment info` summarises one.
+//! (thesis §3.2), written as a `.garment` file; `garment fit` reconstructs one from a dataset's
+//! label maps (NGD, `mannequin_garment::ngd`); `garment info` summarises one.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -8,7 +9,9 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use mannequin_cloth::{MATERIAL_NAMES, Material};
 use mannequin_garment::file::{read_garment, write_garment};
+use mannequin_garment::ngd::{NgdSettings, reconstruct};
 use mannequin_garment::{CATEGORY_NAMES, Category, Ease, Garment, SIZE_NAMES, make_garment};
+use mannequin_io::progress::JobTimer;
 use mannequin_mesh::write_obj;
 
 use crate::shared::BodyArgs;
@@ -22,7 +25,7 @@ pub enum GarmentCommand {
     /// Reconstruct one garment from a dataset's label maps (NGD: a Jacobian field on the
     /// category's template, fitted through the Poisson solve and the differentiable rasteriser):
     /// garment.obj and fit.json.
-    Fit(crate::garment_fit::FitArgs),
+    Fit(FitArgs),
     /// Summarise a .garment file.
     Info {
         /// The .garment file.
@@ -71,10 +74,34 @@ pub struct MakeArgs {
     obj: Option<PathBuf>,
 }
 
+#[derive(Args)]
+pub struct FitArgs {
+    /// The dataset: images' label maps (`labels/`) with their legend (`subject.json`), cameras and
+    /// poses; normal maps (`normals/`) are used when present.
+    #[arg(long)]
+    data: PathBuf,
+    /// The garment to reconstruct, by its category (pants, short-pants, shirt, tshirt,
+    /// long-coat, skirt, dress): the base template and the label it is compared with.
+    #[arg(long)]
+    category: String,
+    /// The label of the legend (`subject.json`'s `labels`) that marks this garment in the label
+    /// maps, when it is not named after the category (a segmenter's "upper", say).
+    #[arg(long)]
+    label: Option<String>,
+    /// The body model the dataset's poses are for.
+    #[arg(long, default_value = "default")]
+    body: String,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    ngd: NgdSettings,
+}
+
 pub fn run(cmd: GarmentCommand) -> Result<()> {
     match cmd {
         GarmentCommand::Make(args) => make(args),
-        GarmentCommand::Fit(args) => crate::garment_fit::fit(args),
+        GarmentCommand::Fit(args) => fit(args),
         GarmentCommand::Info { file, json } => info(&file, json),
     }
 }
@@ -100,6 +127,13 @@ fn make(args: MakeArgs) -> Result<()> {
     }
     tracing::info!("made in {:.1} s", start.elapsed().as_secs_f64());
     println!("{}", serde_json::to_string_pretty(&summary(&args.out, &garment))?);
+    Ok(())
+}
+
+fn fit(args: FitArgs) -> Result<()> {
+    let _timer = JobTimer::start("garment fit");
+    let label = args.label.as_deref().unwrap_or(&args.category);
+    reconstruct(&args.data, &args.category, label, &args.body, &args.ngd, &args.out)?;
     Ok(())
 }
 

@@ -14,8 +14,6 @@ mod face;
 mod face_track;
 mod fit;
 mod garment;
-mod garment_fit;
-mod garment_layers;
 mod logging;
 mod motion;
 mod render;

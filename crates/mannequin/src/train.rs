@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args as ClapArgs;
 use mannequin_avatar::TrainSettings;
+use mannequin_avatar::garment_layer::GarmentLayer;
 use mannequin_avatar::training::{Subject, WornGarments};
+use mannequin_garment::ngd::layers as garment_layers;
 
-use crate::garment_layers;
 use mannequin_io::progress::JobTimer;
 
 #[derive(ClapArgs, Clone)]
@@ -39,13 +40,16 @@ pub fn run(args: Args) -> Result<()> {
         replace_skirt: garments.iter().any(|c| c.flare().is_some()),
     };
     let loaded = subject.load(out, worn)?;
-    let layers = garment_layers::reconstruct_all(
+    let layers: Vec<GarmentLayer> = garment_layers::reconstruct_all(
         &garments,
         (data, &loaded.record().data),
         &settings.body,
         (settings.seed, settings.garment_iters),
         out,
-    )?;
+    )?
+    .into_iter()
+    .map(|g| GarmentLayer { name: g.category, positions: g.positions, faces: g.faces, weights: g.weights })
+    .collect();
     loaded.start(&layers)?.run()?;
     Ok(())
 }

@@ -7,9 +7,9 @@
 
 use glam::{DVec3, Mat3A, Vec3A};
 use mannequin_body::forward;
-use mannequin_data::Camera;
-use mannequin_raster::differentiable::{Rendered, render};
+use mannequin_data::{Camera, Split};
 use mannequin_mesh::normals::{vertex_normals, vertex_normals_backward};
+use mannequin_raster::differentiable::{Rendered, render};
 
 use crate::error::GarmentError;
 use crate::transfer::Dressed;
@@ -26,6 +26,13 @@ pub const CHANNELS: usize = 4;
 pub struct FramePose {
     pub pose: Vec<f32>,
     pub transl: [f32; 3],
+}
+
+impl FramePose {
+    /// Frame `k` of `split` (its `k`th frame, not the dataset's frame number).
+    pub fn of(split: &Split, k: usize) -> Self {
+        Self { pose: split.poses.pose72(k), transl: split.poses.transl[k] }
+    }
 }
 
 pub(crate) struct Scene {
