@@ -8,8 +8,6 @@ pub enum DataError {
     Io(#[from] mannequin_io::IoError),
     #[error(transparent)]
     Mesh(#[from] mannequin_mesh::MeshFileError),
-    #[error(transparent)]
-    Body(#[from] mannequin_body::BodyError),
     #[error("{path}: {reason}")]
     File { path: PathBuf, reason: String },
     #[error("{0}")]

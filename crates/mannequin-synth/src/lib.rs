@@ -5,11 +5,14 @@
 //! (the whole and each garment), label maps and hand masks (see `docs/dataset-format.md`,
 //! "Synthetic subjects").
 
+pub mod error;
 pub mod motion;
 pub mod scene;
 pub mod subject;
 pub mod texture;
 pub mod wardrobe;
+
+pub use error::SynthError;
 
 use std::path::Path;
 
@@ -19,7 +22,6 @@ use serde::Serialize;
 use mannequin_body::BodyModel;
 use mannequin_data::Camera;
 use mannequin_data::dataset::{Cameras, Frame};
-use mannequin_data::error::DataError;
 use mannequin_data::poses::{BODY_POSE_LEN, Poses};
 use mannequin_data::splits::{SplitRange, Splits};
 use mannequin_data::writer::DatasetWriter;
@@ -69,7 +71,7 @@ impl SynthOptions {
         self.capture_frames + self.view_poses * scene::NOVEL_VIEWS + 4 * self.motion_frames
     }
 
-    fn check(&self) -> Result<(), DataError> {
+    fn check(&self) -> Result<(), SynthError> {
         let ok = self.size >= 32
             && self.supersample >= 1
             && self.train_frames >= 1
@@ -80,7 +82,7 @@ impl SynthOptions {
         if ok {
             Ok(())
         } else {
-            Err(DataError::Invalid(format!(
+            Err(SynthError::Invalid(format!(
                 "synthetic capture needs size ≥ 32, supersample ≥ 1, 1 ≤ train frames < capture frames, \
                  1 ≤ view poses ≤ train frames and motion frames ≥ 1; got {self:?}"
             )))
@@ -124,7 +126,7 @@ fn write_frames(
     writer: &DatasetWriter,
     supersample: usize,
     on_frame: &(dyn Fn() + Sync),
-) -> Result<(), DataError> {
+) -> Result<(), SynthError> {
     (0..seq.len()).into_par_iter().try_for_each(|i| {
         let mesh = seq.mesh(scene, i);
         let r = scene.render(&mesh, &cameras[i], supersample);
@@ -152,7 +154,7 @@ pub fn generate(
     out: &Path,
     options: &SynthOptions,
     on_frame: &(dyn Fn() + Sync),
-) -> Result<SynthSummary, DataError> {
+) -> Result<SynthSummary, SynthError> {
     options.check()?;
     let subject = Subject::random(options.seed, model.num_betas().min(10));
     let scene = Scene::new(model, &subject)?;
@@ -236,7 +238,7 @@ pub fn generate(
         labels: scene.legend(),
     };
     let path = out.join("subject.json");
-    let text = serde_json::to_string_pretty(&summary).map_err(|e| DataError::file(&path, e.to_string()))?;
-    mannequin_io::write_atomic(&path, text.as_bytes()).map_err(|e| DataError::os(&path, e))?;
+    let text = serde_json::to_string_pretty(&summary).map_err(|e| SynthError::file(&path, e.to_string()))?;
+    mannequin_io::write_atomic(&path, text.as_bytes()).map_err(|e| SynthError::os(&path, e))?;
     Ok(summary)
 }

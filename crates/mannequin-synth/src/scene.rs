@@ -14,7 +14,7 @@ use crate::texture::{BakeInput, SurfacePoint, bake, smoothstep};
 use crate::wardrobe::{Piece, Worn, dress_subject, triangle_atlas};
 use mannequin_body::smpl_joint as joint;
 use mannequin_data::Camera;
-use mannequin_data::error::DataError;
+use crate::error::SynthError;
 use mannequin_data::image::{Image, Mask};
 use mannequin_data::labels::LabelMap;
 use mannequin_data::maps::{DepthMap, NormalMap};
@@ -145,9 +145,9 @@ fn remap_uv(uv: &UvLayout, offset: f32, scale: f32, base: u32) -> (Vec<[f32; 2]>
 pub const BODY_LABELS: [&str; 4] = ["background", "skin", "hair", "shoes"];
 
 impl Scene {
-    pub fn new(model: &BodyModel, subject: &Subject) -> Result<Self, DataError> {
+    pub fn new(model: &BodyModel, subject: &Subject) -> Result<Self, SynthError> {
         let body_uv = model.uv.as_ref().ok_or_else(|| {
-            DataError::Invalid(format!("body model '{}' has no UV layout to paint a texture on", model.name))
+            SynthError::Invalid(format!("body model '{}' has no UV layout to paint a texture on", model.name))
         })?;
         let shaped = shape_body(model, &subject.betas)?;
         let rest: Vec<[f32; 3]> = points(&shaped.vertices);
@@ -271,7 +271,7 @@ impl Scene {
         poses: &[f32],
         fps: f32,
         subframes: usize,
-    ) -> Result<PosedSequence, DataError> {
+    ) -> Result<PosedSequence, SynthError> {
         let frames = poses.len() / 72;
         let dense: Vec<f32> = (0..frames)
             .flat_map(|f| {
@@ -287,7 +287,7 @@ impl Scene {
         Ok(played.select(&(0..frames).map(|f| f * subframes).collect::<Vec<_>>()))
     }
 
-    fn play(&self, model: &BodyModel, poses: &[f32], fps: f32) -> Result<PosedSequence, DataError> {
+    fn play(&self, model: &BodyModel, poses: &[f32], fps: f32) -> Result<PosedSequence, SynthError> {
         let frames = poses.len() / 72;
         let still = pose_frames(model, &self.shaped, poses, &vec![0.0; 3 * frames])?;
         let lift: Vec<f32> = (0..frames)
@@ -307,7 +307,7 @@ impl Scene {
         };
         let schedule = Settling::new(model, &motion, SETTLE_SECONDS)?;
         let body_frames = schedule.body_frames(model, &self.shaped)?;
-        let fail = |e: GarmentError| DataError::Invalid(format!("dressing the subject: {e}"));
+        let fail = |e: GarmentError| SynthError::Invalid(format!("dressing the subject: {e}"));
         let dressed: Vec<Dressed> = self
             .worn
             .iter()

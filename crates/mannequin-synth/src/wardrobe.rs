@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 use mannequin_body::BodyModel;
-use mannequin_data::error::DataError;
+use crate::error::SynthError;
 use mannequin_garment::{Category, Ease, Garment, make_garment};
 use mannequin_mesh::{TriMesh, UvLayout};
 
@@ -47,11 +47,11 @@ impl Outfit {
 }
 
 /// Makes `outfit` on `model` with shape `betas`, each layer clear of those under it.
-pub fn dress_subject(model: &BodyModel, betas: &[f32], outfit: Outfit) -> Result<Vec<Worn>, DataError> {
+pub fn dress_subject(model: &BodyModel, betas: &[f32], outfit: Outfit) -> Result<Vec<Worn>, SynthError> {
     let mut worn: Vec<Worn> = Vec::new();
     for &(category, size, piece) in outfit.garments() {
         let fail = |e: mannequin_garment::GarmentError| {
-            DataError::Invalid(format!("making the {}: {e}", category.name()))
+            SynthError::Invalid(format!("making the {}: {e}", category.name()))
         };
         let fit = Ease::size(size).map_err(fail)?;
         let made = make_garment(category, fit, EDGE, category.default_material(), model, "default", betas)
