@@ -7,8 +7,7 @@ use mannequin_data::Image;
 
 use crate::crop::{Border, RotatedRect, crop};
 use crate::error::FitError;
-use crate::network::Network;
-use crate::pose_landmarker::sigmoid;
+use crate::network::{Network, sigmoid};
 use crate::ssd_detector::Detection;
 
 pub const INPUT_SIZE: usize = 192;

@@ -12,6 +12,10 @@ use crate::ssd_detector::{Detection, FACE};
 const FACE_DETECTION: &[u8] = include_bytes!("../models/face_detection_short_range.onnx");
 const FACE_LANDMARK: &[u8] = include_bytes!("../models/face_landmark.onnx");
 
+/// The face mesh reads a 192² crop 1.5× the face box: a box much under 48 pixels is upsampled
+/// past what the network saw in training.
+pub const MIN_FACE_PX: f32 = 48.0;
+
 /// The two networks, ready to run.
 pub struct FaceModels {
     pub detector: Network,

@@ -3,9 +3,9 @@
 //! truth is known.
 
 use glam::{DVec3, Vec3};
-use mannequin_raster::{Raster, RasterMesh, Shading, rasterize};
 use mannequin_data::{Camera, Image};
 use mannequin_mesh::normals::vertex_normals;
+use mannequin_raster::{Raster, RasterMesh, Shading, rasterize};
 
 /// A head placed in the camera, with its colours and light.
 pub struct LitHead<'a> {

@@ -15,9 +15,9 @@
 //! differentiable rasteriser.
 
 use glam::DVec3;
-use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 use mannequin_data::{Camera, Image};
 use mannequin_mesh::normals::vertex_normals;
+use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 
 use crate::error::FitError;
 

@@ -82,3 +82,8 @@ impl Network {
         })
     }
 }
+
+/// A network's logit as a probability.
+pub(crate) fn sigmoid(x: f32) -> f32 {
+    1.0 / (1.0 + (-x).exp())
+}

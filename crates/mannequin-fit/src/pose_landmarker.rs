@@ -8,7 +8,7 @@ use mannequin_data::{Image, Mask};
 use crate::blazepose;
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
-use crate::network::Network;
+use crate::network::{Network, sigmoid};
 use crate::ssd_detector::Detection;
 
 pub const INPUT_SIZE: usize = 256;
@@ -75,10 +75,6 @@ impl PoseLandmarks {
             ..*self
         }
     }
-}
-
-pub(crate) fn sigmoid(x: f32) -> f32 {
-    1.0 / (1.0 + (-x).exp())
 }
 
 /// MediaPipe's AlignmentPointsRects + RectTransformation: a square centred on `centre`, its

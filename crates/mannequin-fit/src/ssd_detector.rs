@@ -9,8 +9,7 @@ use mannequin_data::Image;
 
 use crate::crop::{Border, RotatedRect, crop};
 use crate::error::FitError;
-use crate::network::Network;
-use crate::pose_landmarker::sigmoid;
+use crate::network::{Network, sigmoid};
 
 /// Scores are logits clipped to ±100; MediaPipe keeps detections at probability ≥ 0.5.
 const SCORE_CLIP: f32 = 100.0;

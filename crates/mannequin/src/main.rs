@@ -11,7 +11,6 @@ mod dress;
 mod eval;
 mod export;
 mod face;
-mod face_track;
 mod fit;
 mod garment;
 mod logging;
@@ -23,7 +22,6 @@ mod splat;
 mod staging;
 mod synth;
 mod train;
-mod video_input;
 mod view;
 
 use clap::{Parser, Subcommand};

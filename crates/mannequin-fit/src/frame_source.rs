@@ -1,16 +1,16 @@
-//! Where the video commands (`capture`, `face track`) take their frames from: a folder of images,
-//! or a video file decoded by the ffmpeg program.
+//! Where the video pipelines (capture, face tracking) take their frames from: a folder of
+//! images, or a video file decoded by the ffmpeg program.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use anyhow::{Context, Result, bail};
 use mannequin_data::layout::IMAGE_EXTENSIONS;
 
-use crate::checkpoint::file_hash;
+use crate::error::FitError;
 
-#[derive(clap::Args)]
-pub struct VideoArgs {
+/// A clip's frames: a folder of images or a video, and how many of them to take.
+#[derive(Clone, Debug, Default, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
+pub struct FrameSource {
     /// A folder of frames (PNG or JPEG), taken in file-name order.
     #[arg(long, conflicts_with = "video", required_unless_present = "video")]
     pub frames: Option<PathBuf>,
@@ -26,26 +26,26 @@ pub struct VideoArgs {
     pub max_frames: Option<usize>,
 }
 
-/// A command's frames, and the folder they are in.
+/// A pipeline's frames, and the folder they are in.
 pub struct Frames {
     pub dir: PathBuf,
     pub files: Vec<PathBuf>,
-    /// Whether `dir` was decoded from the video (and is the command's to remove).
+    /// Whether `dir` was decoded from the video (and is the pipeline's to remove).
     pub decoded: bool,
 }
 
-impl VideoArgs {
+impl FrameSource {
     /// The frames, the video first decoded into `scratch/.frames`; at most `--max-frames`.
-    pub fn frames(&self, scratch: &Path) -> Result<Frames> {
+    pub fn frames(&self, scratch: &Path) -> Result<Frames, FitError> {
         if let Some(fps) = self.fps
             && !(fps.is_finite() && fps > 0.0)
         {
-            bail!("--fps {fps}: expected a positive frame rate");
+            return Err(FitError::Setting(format!("--fps {fps}: expected a positive frame rate")));
         }
         let (dir, decoded) = match (&self.video, &self.frames) {
             (Some(video), _) => (decode_video(video, self.fps, scratch)?, true),
             (None, Some(dir)) => (dir.clone(), false),
-            (None, None) => bail!("give --frames DIR or --video FILE"),
+            (None, None) => return Err(FitError::Setting("give --frames DIR or --video FILE".into())),
         };
         let mut files = image_files(&dir)?;
         if let Some(n) = self.max_frames {
@@ -56,7 +56,7 @@ impl VideoArgs {
 
     /// The video's name and hash, or each frame file's: a checkpoint resumes only on the same
     /// input.
-    pub fn source(&self, files: &[PathBuf]) -> Result<Vec<String>> {
+    pub fn fingerprint(&self, files: &[PathBuf]) -> Result<Vec<String>, FitError> {
         match &self.video {
             Some(video) => Ok(vec![format!("{} {}", video.display(), file_hash(video)?)]),
             None => files.iter().map(|f| Ok(format!("{} {}", f.display(), file_hash(f)?))).collect(),
@@ -64,14 +64,20 @@ impl VideoArgs {
     }
 }
 
+/// The hash of a file's bytes: tells an edited input from the one a checkpoint ran.
+fn file_hash(path: &Path) -> Result<String, FitError> {
+    let bytes = std::fs::read(path).map_err(FitError::file("reading", path))?;
+    Ok(mannequin_io::fingerprint::hash_bytes(&bytes))
+}
+
 /// Decodes `video` into PNG frames under `out/.frames` with ffmpeg.
-fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
+fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf, FitError> {
     if !video.is_file() {
-        bail!("{}: no such video file", video.display());
+        return Err(FitError::input(video.display().to_string(), "no such video file"));
     }
     let dir = out.join(".frames");
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(FitError::file("creating", &dir))?;
     let mut cmd = Command::new("ffmpeg");
     cmd.args(["-loglevel", "error", "-i"]).arg(video);
     if let Some(f) = fps {
@@ -79,21 +85,27 @@ fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf> {
     }
     let status = match cmd.arg(dir.join("%06d.png")).status() {
         Ok(s) => s,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
-            "--video needs the ffmpeg program, which is not on PATH: install it (Debian/Ubuntu: \
-             sudo apt-get install ffmpeg; macOS: brew install ffmpeg), or pass --frames DIR with the frames as images"
-        ),
-        Err(e) => bail!("running ffmpeg: {e}"),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(FitError::Setting(
+                "--video needs the ffmpeg program, which is not on PATH: install it (Debian/Ubuntu: \
+                 sudo apt-get install ffmpeg; macOS: brew install ffmpeg), or pass --frames DIR with the frames as images"
+                    .into(),
+            ));
+        }
+        Err(e) => return Err(FitError::file("running", "ffmpeg")(e)),
     };
     if !status.success() {
-        bail!("{}: ffmpeg could not decode it ({status})", video.display());
+        return Err(FitError::input(
+            video.display().to_string(),
+            format!("ffmpeg could not decode it ({status})"),
+        ));
     }
     Ok(dir)
 }
 
 /// The image files of a folder, in name order.
-fn image_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
+fn image_files(dir: &Path) -> Result<Vec<PathBuf>, FitError> {
+    let entries = std::fs::read_dir(dir).map_err(FitError::file("reading", dir))?;
     let mut files: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
