@@ -2,7 +2,7 @@
 //! and writing the scene, one line each with the file or field at fault.
 
 use mannequin_body::BodyError;
-use mannequin_cloth::ClothError;
+use mannequin_cloth::{ClothError, SimulateError};
 use mannequin_io::IoError;
 use mannequin_mesh::MeshFileError;
 
@@ -14,6 +14,8 @@ pub enum DressError {
     Invalid { field: String, reason: String },
     #[error("reading {path}: {reason}")]
     Read { path: String, reason: String },
+    #[error("writing {path}: {reason}")]
+    Write { path: String, reason: String },
     /// `inner` said of `context` (a file, a garment): one line, as `anyhow`'s context reads.
     #[error("{context}: {inner}")]
     In { context: String, inner: Box<DressError> },
@@ -21,6 +23,8 @@ pub enum DressError {
     Garment(#[from] GarmentError),
     #[error(transparent)]
     Cloth(#[from] ClothError),
+    #[error(transparent)]
+    Simulate(#[from] SimulateError),
     #[error(transparent)]
     Body(#[from] BodyError),
     #[error(transparent)]

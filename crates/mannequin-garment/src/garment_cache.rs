@@ -9,8 +9,8 @@ use mannequin_body::BodyModel;
 
 use crate::category::{CATEGORY_NAMES, Category};
 use crate::dress_error::DressError;
-use crate::file::{read_garment, write_garment};
 use crate::ease::Ease;
+use crate::file::{read_garment, write_garment};
 use crate::garment::Garment;
 use crate::make::{TEMPLATE_REVISION, make_garment};
 
@@ -40,8 +40,8 @@ pub fn load_or_make(
         return Ok((name, garment));
     };
     let body_key = if Path::new(body).exists() {
-        let bytes =
-            std::fs::read(body).map_err(|e| DressError::Read { path: body.to_string(), reason: e.to_string() })?;
+        let bytes = std::fs::read(body)
+            .map_err(|e| DressError::Read { path: body.to_string(), reason: e.to_string() })?;
         mannequin_io::fingerprint::hash_bytes(&bytes)
     } else {
         body.to_string()
@@ -57,8 +57,15 @@ pub fn load_or_make(
         return Ok((category.name().to_string(), garment));
     }
     let start = Instant::now();
-    let garment =
-        make_garment(category, Ease::size(size)?, EDGE_LENGTH, category.default_material(), model, body, &[])?;
+    let garment = make_garment(
+        category,
+        Ease::size(size)?,
+        EDGE_LENGTH,
+        category.default_material(),
+        model,
+        body,
+        &[],
+    )?;
     tracing::info!("{}: made in {:.1} s", category.name(), start.elapsed().as_secs_f64());
     if let Some(path) = &cache {
         let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(|e| e.to_string());

@@ -4,7 +4,6 @@
 mod animate;
 mod body;
 mod capture;
-mod checkpoint;
 mod cloth;
 mod demo;
 mod dress;
@@ -17,7 +16,6 @@ mod logging;
 mod motion;
 mod render;
 mod shared;
-mod sim_limits;
 mod splat;
 mod staging;
 mod synth;

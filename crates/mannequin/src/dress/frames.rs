@@ -6,14 +6,14 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use mannequin_data::image::Image;
-use mannequin_raster::{RasterMesh, Shading, rasterize};
 use mannequin_mesh::normals::vertex_normals;
+use mannequin_raster::{RasterMesh, Shading, rasterize};
 use mannequin_splat::Camera;
 use rayon::prelude::*;
 
+use mannequin_io::progress::bar;
 use mannequin_io::write_video;
 use mannequin_splat::clip_camera;
-use mannequin_io::progress::bar;
 
 /// Skin's colour, linear RGB.
 const SKIN: [f32; 3] = [0.8, 0.6, 0.5];

@@ -39,7 +39,7 @@ pub struct RegionFit {
 /// The report for one garment at one frame: `positions` on the body `body`/`body_faces`,
 /// `rest` its unstretched shape, `weights` its skinning weights (N × `joints`).
 #[allow(clippy::too_many_arguments)]
-pub fn fit_report(
+pub(super) fn fit_report(
     positions: &[[f32; 3]],
     rest: &[[f32; 3]],
     faces: &[[u32; 3]],

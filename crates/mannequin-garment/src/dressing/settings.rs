@@ -1,0 +1,65 @@
+//! `dress`'s settings: the size garments given by category are made at, the solver's substeps,
+//! the settling time, whether the cloth is simulated at all and with self-contacts (what changes
+//! the result), and how often a checkpoint is saved. Each default is written here once; the
+//! command line reads it from [`DressSettings::default`].
+
+use mannequin_cloth::sim_limits::{MAX_SUBSTEPS, parse_settle};
+use mannequin_cloth::{SETTLE_SECONDS, SUBSTEPS};
+use serde::{Deserialize, Serialize};
+
+use crate::ease::SIZE_NAMES;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, clap::Args)]
+pub struct DressSettings {
+    /// The size of garments given by category name.
+    #[arg(
+        long = "size",
+        default_value_t = DressSettings::default().size,
+        value_parser = clap::builder::PossibleValuesParser::new(SIZE_NAMES)
+    )]
+    pub size: String,
+    /// Simulation substeps per frame, at most 100.
+    #[arg(
+        long = "substeps",
+        default_value_t = DressSettings::default().substeps,
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(u32).range(1..=MAX_SUBSTEPS as i64)
+    )]
+    pub substeps: u32,
+    /// Seconds before the motion: half at rest, half blending into its first frame (at most 10).
+    #[arg(
+        long = "settle",
+        default_value_t = DressSettings::default().settle,
+        allow_hyphen_values = true,
+        value_parser = parse_settle
+    )]
+    pub settle: f32,
+    /// Skin the garments only (Eqs. 3.2–3.3), without the cloth simulator.
+    #[arg(long = "no-simulation")]
+    pub no_simulation: bool,
+    /// Cloth–cloth contacts within each garment (vertex–triangle and edge–edge); slow, see
+    /// `cloth simulate --self-collision`.
+    #[arg(long = "self-collision")]
+    pub self_collision: bool,
+    /// Save a checkpoint every this many simulated frames (0: never); a re-run of the same
+    /// command goes on from it.
+    #[arg(long = "checkpoint-every", default_value_t = DressSettings::default().checkpoint_every)]
+    pub checkpoint_every: usize,
+    /// Start over even if the folder holds a checkpoint.
+    #[arg(long = "restart")]
+    pub restart: bool,
+}
+
+impl Default for DressSettings {
+    fn default() -> Self {
+        Self {
+            size: "M".into(),
+            substeps: SUBSTEPS,
+            settle: SETTLE_SECONDS,
+            no_simulation: false,
+            self_collision: false,
+            checkpoint_every: 60,
+            restart: false,
+        }
+    }
+}
