@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use burn::tensor::Device;
 use mannequin_data::evaluation::{EvalOptions, evaluate};
-use mannequin_data::staged::StagedDir;
+use mannequin_io::staging::StagedDir;
 use mannequin_data::{Dataset, Scores, TestSet};
 
 use crate::avatar::Avatar;
@@ -43,7 +43,7 @@ pub fn evaluate_avatar(
         let frames = dataset.split("test")?.frames;
         let out = model.join("eval").join(set.name());
         let temp = model.join(format!(".eval-{}.partial-{}", set.name(), std::process::id()));
-        let stage = StagedDir::new(temp, out.clone())?;
+        let stage = StagedDir::new(temp, out.clone()).map_err(mannequin_data::DataError::from)?;
         on_set(set, frames.len());
         predict_split(&avatar, &dataset, "test", stage.path(), on_frame)?;
         let mut summary = evaluate(stage.path(), &dir, &frames, options, &|_| on_frame())?;
@@ -52,7 +52,7 @@ pub fn evaluate_avatar(
         staged.push(stage);
     }
     for stage in staged {
-        stage.keep()?;
+        stage.keep().map_err(mannequin_data::DataError::from)?;
     }
     Ok(Scores::new(summaries))
 }

@@ -8,6 +8,8 @@ pub enum DataError {
     Io(#[from] mannequin_io::IoError),
     #[error(transparent)]
     Mesh(#[from] mannequin_mesh::MeshFileError),
+    #[error(transparent)]
+    Staging(#[from] mannequin_io::staging::StagingError),
     #[error("{path}: {reason}")]
     File { path: PathBuf, reason: String },
     #[error("{0}")]

@@ -15,7 +15,6 @@ pub mod metrics;
 pub mod poses;
 pub mod scores;
 pub mod splits;
-pub mod staged;
 pub mod writer;
 
 pub use dataset::{Cameras, Dataset, Frame, Split};

@@ -15,6 +15,7 @@ pub mod ply_header;
 pub mod progress;
 pub mod rng;
 pub mod run_record;
+pub mod staging;
 pub mod video;
 
 pub use atomic::{write_atomic, write_atomic_with};

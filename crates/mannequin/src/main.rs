@@ -17,7 +17,6 @@ mod motion;
 mod render;
 mod shared;
 mod splat;
-mod staging;
 mod synth;
 mod train;
 mod view;
