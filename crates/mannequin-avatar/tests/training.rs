@@ -1,13 +1,14 @@
 //! Training as a user relies on it: a run resumed from a checkpoint ends bit-identical to an
 //! uninterrupted one (and a run of another length is refused), a non-finite loss stops the run naming the iteration, the loss falls on a
-//! real (small) synthetic subject, and a dataset with a missing piece fails before training.
+//! real (small) synthetic subject, a dataset with a missing piece fails before training, and a
+//! run goes to its one iteration count, checkpointing on the way, and saves the avatar.
 
 use std::path::{Path, PathBuf};
 
 use burn::tensor::Device;
 use mannequin_avatar::{
     Avatar, AvatarConfig, AvatarError, Canonical, Checkpoint, Method, SkirtMode, TrainOptions, Trainer,
-    TrainingRun, load_views,
+    Training, TrainingRun, checkpoint_path, load_views,
 };
 use mannequin_body::BodyModel;
 use mannequin_data::Dataset;
@@ -130,6 +131,18 @@ fn loss_falls_and_a_nan_stops_the_run_naming_the_iteration() {
         Err(AvatarError::NonFiniteLoss { iteration, .. }) => assert_eq!(iteration, 41),
         other => panic!("expected a non-finite loss error, got {:?}", other.map(|s| s.loss)),
     }
+    std::fs::remove_dir_all(data).ok();
+}
+
+#[test]
+fn a_run_trains_to_its_iterations_and_saves_the_avatar() {
+    let data = subject("run");
+    let out = data.join("model");
+    let trainer = trainer(&data, Method::Tavatar, 3);
+    let run = record(&trainer, &data);
+    Training { trainer, record: run.clone(), checkpoint_every: 2, out: out.clone() }.run().unwrap();
+    assert_eq!(Checkpoint::open(&checkpoint_path(&out), &run, &[]).unwrap().iteration, 3);
+    assert!(Avatar::load(&out, &Device::flex()).is_ok(), "no avatar in {}", out.display());
     std::fs::remove_dir_all(data).ok();
 }
 

@@ -40,7 +40,8 @@ impl Training {
                 Ok(s) => s,
                 Err(AvatarError::NonFiniteLoss { iteration, value, .. }) => {
                     progress.abandon();
-                    let last = if checkpoint.exists() { checkpoint.display().to_string() } else { "none".into() };
+                    let last =
+                        if checkpoint.exists() { checkpoint.display().to_string() } else { "none".into() };
                     return Err(AvatarError::NonFiniteLoss { iteration, value, checkpoint: last });
                 }
                 Err(e) => return Err(e),

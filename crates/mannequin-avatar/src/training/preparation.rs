@@ -82,7 +82,7 @@ impl Subject {
             downscale: s.downscale,
             skirt,
             garments: (!garments.names.is_empty())
-                .then(|| GarmentRecord { categories: garments.names, steps: s.garment_iters }),
+                .then_some(GarmentRecord { categories: garments.names, steps: s.garment_iters }),
             data: self.dataset.fingerprint(&self.split)?,
             avatar: s.avatar_config(),
             options: s.options(),
@@ -137,7 +137,11 @@ impl LoadedSubject {
         let mut trainer = Trainer::new(avatar, views, record.options.clone())?;
         if let Some(saved) = &resume {
             trainer.resume(saved, &record).map_err(AvatarError::cannot_resume)?;
-            tracing::info!("resuming from {} at iteration {}", checkpoint_path(&out).display(), trainer.iteration);
+            tracing::info!(
+                "resuming from {} at iteration {}",
+                checkpoint_path(&out).display(),
+                trainer.iteration
+            );
         }
         tracing::info!(
             "{} Gaussians on {} vertices, {} views, {} iterations",
