@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use burn::tensor::Device;
 use mannequin_data::evaluation::{EvalOptions, evaluate};
-use mannequin_io::staging::StagedDir;
 use mannequin_data::{Dataset, Scores, TestSet};
+use mannequin_io::staging::StagedDir;
 
 use crate::avatar::Avatar;
 use crate::error::AvatarError;

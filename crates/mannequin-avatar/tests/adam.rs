@@ -9,8 +9,8 @@ use std::path::PathBuf;
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::adam::Adam;
 use mannequin_avatar::params::Param;
-use mannequin_io::rng::SplitMix64;
 use mannequin_io::limits::FLOAT32;
+use mannequin_io::rng::SplitMix64;
 use mannequin_io::{Npz, NpzWriter};
 
 /// Name, shape, learning rate and the first step with a gradient, per parameter.
