@@ -23,7 +23,7 @@ pub struct NgdSettings {
     #[arg(long = "size", default_value_t = NgdSettings::default().size)]
     pub size: String,
     /// Optimisation steps (one training frame each).
-    #[arg(long = "iters", default_value_t = NgdSettings::default().steps)]
+    #[arg(long = "iters", value_name = "ITERS", default_value_t = NgdSettings::default().steps)]
     pub steps: usize,
     /// Adam's step size on the static Jacobian field.
     #[arg(long = "rate", default_value_t = NgdSettings::default().rate)]
