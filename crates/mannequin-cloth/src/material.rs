@@ -94,6 +94,12 @@ const LEATHER: Material = Material {
 };
 
 impl Material {
+    pub const COTTON: Material = COTTON;
+    pub const DENIM: Material = DENIM;
+    pub const SILK: Material = SILK;
+    pub const JERSEY: Material = JERSEY;
+    pub const LEATHER: Material = LEATHER;
+
     /// The fabric called `name` (one of [`MATERIAL_NAMES`]).
     pub fn named(name: &str) -> Result<Material, ClothError> {
         MATERIALS.into_iter().find(|m| m.name == name).ok_or_else(|| ClothError::UnknownMaterial {

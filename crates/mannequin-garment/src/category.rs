@@ -1,5 +1,6 @@
 //! Garment categories (the thesis's MGN templates, §3.2) and where each one covers the body.
 
+use mannequin_cloth::Material;
 use serde::{Deserialize, Serialize};
 
 use crate::error::GarmentError;
@@ -45,13 +46,13 @@ impl Category {
         CATEGORY_NAMES[Category::ALL.iter().position(|&c| c == self).unwrap_or(0)]
     }
 
-    /// The cloth it is made of unless told otherwise (a `mannequin-cloth` material name).
-    pub fn default_material(self) -> &'static str {
+    /// The cloth it is made of unless told otherwise.
+    pub fn default_material(self) -> Material {
         match self {
-            Category::Pants | Category::LongCoat => "denim",
-            Category::ShortPants | Category::Shirt | Category::Skirt => "cotton",
-            Category::Tshirt => "jersey",
-            Category::Dress => "silk",
+            Category::Pants | Category::LongCoat => Material::DENIM,
+            Category::ShortPants | Category::Shirt | Category::Skirt => Material::COTTON,
+            Category::Tshirt => Material::JERSEY,
+            Category::Dress => Material::SILK,
         }
     }
 

@@ -52,6 +52,7 @@ impl Garment {
 mod tests {
     use super::*;
     use crate::{Category, Ease, Recipe};
+    use mannequin_cloth::Material;
     use mannequin_mesh::{SurfacePoint, TriMesh};
 
     fn hanging(model: &BodyModel, faces_hung: &[u32], offset: f32) -> Garment {
@@ -59,7 +60,7 @@ mod tests {
             category: Category::Tshirt,
             fit: Ease::size("M").unwrap(),
             edge_length: 0.015,
-            material: "cotton".into(),
+            material: Material::COTTON,
             body: "test".into(),
             betas: vec![],
             body_vertices: model.num_vertices(),

@@ -34,7 +34,7 @@ pub fn make_garment(
     category: Category,
     fit: Ease,
     edge_length: f32,
-    material: &str,
+    material: Material,
     model: &BodyModel,
     body_name: &str,
     betas: &[f32],
@@ -74,7 +74,7 @@ pub fn make_garment(
     let panel = category.flare().filter(|_| depth > 2.0 * edge_length);
     if panel.is_some() || category == Category::LongCoat {
         let sewn = match panel {
-            Some(flare) => sew_skirt(&mesh, depth, flare, edge_length, &Material::named(material)?, &body)?,
+            Some(flare) => sew_skirt(&mesh, depth, flare, edge_length, &material, &body)?,
             None => mesh,
         };
         // The coat opens down the front, through bodice and skirt at once.
@@ -90,7 +90,7 @@ pub fn make_garment(
         category,
         fit,
         edge_length,
-        material: material.to_string(),
+        material,
         body: body_name.to_string(),
         betas: betas.to_vec(),
         body_vertices: model.num_vertices(),

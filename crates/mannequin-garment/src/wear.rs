@@ -5,7 +5,7 @@
 //! each frame with what a checkpoint needs, and resumes from such a checkpoint bit for bit.
 
 use mannequin_body::Settling;
-use mannequin_cloth::{Attachment, Body, Cloth, ClothState, Material, PhaseTimes, Settings, Simulator};
+use mannequin_cloth::{Attachment, Body, Cloth, ClothState, PhaseTimes, Settings, Simulator};
 use mannequin_mesh::TriMesh;
 use mannequin_mesh::adjacency::boundary_loops_by_height;
 
@@ -161,7 +161,7 @@ fn simulate_layer<E: From<GarmentError>>(
     let rest = dressed.rest();
     let mut mesh = garment.mesh.clone();
     mesh.positions = rest.clone();
-    let material = Material::named(&garment.recipe.material).map_err(GarmentError::from)?;
+    let material = garment.recipe.material;
     let failed =
         |when: String| move |source| GarmentError::Simulation { garment: name.to_string(), when, source };
     let cloth = Cloth::new(&mesh, &material, &[]).map_err(failed("at rest".into()))?;

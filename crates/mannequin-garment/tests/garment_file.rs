@@ -25,7 +25,7 @@ fn square_garment() -> Garment {
         category: Category::Tshirt,
         fit: Ease::size("M").unwrap(),
         edge_length: 0.015,
-        material: "cotton".into(),
+        material: mannequin_cloth::Material::COTTON,
         body: "default-lod1".into(),
         betas: vec![],
         body_vertices: model.num_vertices(),

@@ -23,7 +23,7 @@ fn the_body_as_a_garment_poses_as_the_body() {
         category: Category::Tshirt,
         fit: Ease::size("M").unwrap(),
         edge_length: 0.015,
-        material: "cotton".into(),
+        material: mannequin_cloth::Material::COTTON,
         body: "default-lod1".into(),
         betas: vec![],
         body_vertices: model.num_vertices(),

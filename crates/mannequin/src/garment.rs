@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
-use mannequin_cloth::{MATERIAL_NAMES, Material};
+use mannequin_cloth::Material;
 use mannequin_garment::file::{read_garment, write_garment};
 use mannequin_garment::ngd::{NgdSettings, reconstruct};
 use mannequin_garment::{CATEGORY_NAMES, Category, Ease, Garment, SIZE_NAMES, make_garment};
@@ -62,8 +62,8 @@ pub struct MakeArgs {
     #[arg(long, default_value_t = 0.015)]
     edge_length: f32,
     /// Cloth material; the category's by default.
-    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(MATERIAL_NAMES))]
-    material: Option<String>,
+    #[arg(long, value_enum)]
+    material: Option<Material>,
     #[command(flatten)]
     body: BodyArgs,
     /// The .garment file to write.
@@ -114,12 +114,11 @@ fn make(args: MakeArgs) -> Result<()> {
     fit.ease_hips = args.ease_hips.unwrap_or(fit.ease_hips);
     fit.hem_height = args.length;
     fit.sleeve = args.sleeve;
-    let material = args.material.clone().unwrap_or_else(|| category.default_material().to_string());
-    Material::named(&material)?;
+    let material = args.material.unwrap_or_else(|| category.default_material());
     let model = load_body(&args.body.body)?;
     let start = Instant::now();
     let garment =
-        make_garment(category, fit, args.edge_length, &material, &model, &args.body.body, &args.body.betas)
+        make_garment(category, fit, args.edge_length, material, &model, &args.body.body, &args.body.betas)
             .with_context(|| format!("making a {}", category.name()))?;
     write_garment(&args.out, &garment).with_context(|| format!("writing {}", args.out.display()))?;
     if let Some(obj) = &args.obj {

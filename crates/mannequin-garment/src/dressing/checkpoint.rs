@@ -8,7 +8,7 @@ use mannequin_cloth::run_checkpoint::{add_state, check_run, frames_array, read_f
 use mannequin_io::{Npz, NpzWriter};
 use serde::{Deserialize, Serialize};
 
-use super::Worn;
+use super::worn::Worn;
 use crate::dress_error::DressError;
 use crate::garment::Garment;
 use crate::transfer::Dressed;

@@ -1,13 +1,14 @@
 //! How well each dressed frame went, per garment: vertices inside the body, triangles crossing
 //! the layers under it, edge strain and stretch; written as metrics.json with the stage times.
 
+use std::ops::Range;
 use std::path::Path;
 
 use mannequin_cloth::quality;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::{Dressing, Worn};
+use super::worn::Worn;
 use crate::dress_error::DressError;
 
 /// Per garment and motion frame, what went wrong where.
@@ -23,16 +24,22 @@ pub struct FrameMetrics {
     pub p99_edge_stretch: f32,
 }
 
-/// Every garment's metrics at every motion frame of `d`.
-pub(super) fn measure(d: &Dressing) -> Vec<Vec<FrameMetrics>> {
-    let (worn, layers) = (&d.worn, &d.layers);
+/// Every garment's metrics at the motion's frames (`motion`, of the schedule): `worn` at
+/// `layers` (per garment, per schedule frame) on `body` (per schedule frame, and its triangles).
+pub(super) fn measure(
+    worn: &[Worn],
+    layers: &[Vec<Vec<[f32; 3]>>],
+    (body_frames, body_faces): (&[Vec<[f32; 3]>], &[[u32; 3]]),
+    motion: Range<usize>,
+) -> Vec<Vec<FrameMetrics>> {
     worn.iter()
         .enumerate()
         .map(|(i, w)| {
             let rest = w.dressed.rest();
             let faces = &w.garment.mesh.faces;
             // Frames are independent: measure them in parallel.
-            d.motion_frames()
+            motion
+                .clone()
                 .into_par_iter()
                 .map(|k| {
                     let positions = &layers[i][k];
@@ -48,11 +55,11 @@ pub(super) fn measure(d: &Dressing) -> Vec<Vec<FrameMetrics>> {
                         })
                         .sum();
                     FrameMetrics {
-                        frame: k - d.schedule.settle,
+                        frame: k - motion.start,
                         vertices_inside_body: quality::vertices_inside_body(
                             positions,
-                            &d.body_frames[k],
-                            &d.body_faces,
+                            &body_frames[k],
+                            body_faces,
                         ),
                         crossings_with_inner_layers,
                         max_edge_strain,

@@ -8,15 +8,16 @@ mod checkpoint;
 mod fit_report;
 mod metrics;
 mod settings;
+mod worn;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mannequin_body::{BodyModel, Motion, Settling, shape_body};
+use mannequin_cloth::Settings;
 use mannequin_cloth::run_checkpoint::{CHECKPOINT, file_hash};
 use mannequin_cloth::sim_limits::check_kept_positions;
-use mannequin_cloth::{Material, Settings};
 use mannequin_mesh::MorphSequence;
 
 use crate::dress_error::DressError;
@@ -29,6 +30,7 @@ use checkpoint::{DressRun, read_checkpoint, template_hash, write_checkpoint};
 pub use fit_report::RegionFit;
 pub use metrics::FrameMetrics;
 pub use settings::DressSettings;
+pub use worn::Worn;
 
 /// How far (m) each layer stands beyond the one under it at rest: twice the simulator's body
 /// margin, so the outer layer starts clear of the inner one's collision shell.
@@ -80,14 +82,6 @@ impl Wardrobe {
     }
 }
 
-/// One garment being worn: its name in the outputs, template, material and transfer to the body.
-pub struct Worn<'a> {
-    pub name: String,
-    pub garment: &'a Garment,
-    pub material: Material,
-    pub dressed: Dressed<'a>,
-}
-
 /// A dressing done: every layer's positions and the body's at every frame of the schedule
 /// (settling included), and the seconds each stage took.
 pub struct Dressing<'a> {
@@ -123,7 +117,7 @@ pub fn dress<'a>(
             } else {
                 name.clone()
             };
-            let material = Material::named(&garment.recipe.material)?;
+            let material = garment.recipe.material;
             Ok(Worn { name, garment, material, dressed })
         })
         .collect::<Result<_, DressError>>()?;
@@ -274,7 +268,8 @@ impl<'a> Dressing<'a> {
     /// Every garment's metrics at every motion frame (timed as stage "metrics").
     pub fn measure(&mut self) -> Vec<Vec<FrameMetrics>> {
         let start = Instant::now();
-        let metrics = metrics::measure(self);
+        let body = (self.body_frames.as_slice(), self.body_faces.as_slice());
+        let metrics = metrics::measure(&self.worn, &self.layers, body, self.motion_frames());
         self.time("metrics", start);
         metrics
     }
