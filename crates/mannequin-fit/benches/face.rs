@@ -1,4 +1,4 @@
-//! Issue 22's face benchmark, through the CLI a user runs.
+//! Issue 22's face benchmark, through the pipelines `mannequin face fit` and `face track` run.
 //!
 //! - **Synthetic:** random faces of the face model itself (shape α, three expression units,
 //!   head pose, light) rendered at three sizes with the colours `face fit` takes from
@@ -10,10 +10,9 @@
 //! - **Speed:** one image (the fit's own time), and `face track` on a rendered clip (frames per
 //!   second, and the per-vertex error through it).
 //!
-//! `cargo bench -p mannequin --bench face -- [--seed S] [--faces N]`
+//! `cargo bench -p mannequin-fit --bench face -- [--seed S] [--faces N]`
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use glam::{DQuat, DVec3};
 use mannequin_body::{BodyModel, FaceModel};
@@ -21,6 +20,9 @@ use mannequin_data::Image;
 use mannequin_io::rng::SplitMix64;
 use mannequin_fit::body_fit::picture_camera;
 use mannequin_fit::face_landmark_table::FaceLandmarkTable;
+use mannequin_fit::face_photo::fit_face_photo;
+use mannequin_fit::frame_source::FrameSource;
+use mannequin_fit::{FaceTrackSettings, FitSettings, track_face};
 use mannequin_fit::face_render::{LitHead, render_head};
 use mannequin_fit::rigid_alignment::best_rotation;
 use mannequin_mesh::read_obj;
@@ -37,20 +39,19 @@ const HEAD_WIDTH: f64 = 0.16;
 /// Expression units each face shows.
 const UNITS: usize = 3;
 
-fn mannequin(args: &[&str]) -> Result<(), String> {
-    let out = Command::new(env!("CARGO_BIN_EXE_mannequin")).args(args).output().unwrap();
-    match out.status.success() {
-        true => Ok(()),
-        false => Err(String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("").to_string()),
-    }
+/// `mannequin face fit --image image --out out`; its error's text when it refuses.
+fn face_fit(image: &Path, out: &Path) -> Result<(), String> {
+    fit_face_photo(image, &FitSettings::default(), out).map(drop).map_err(|e| e.to_string())
 }
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+/// `mannequin face track --frames frames --out out`.
+fn face_track(frames: &Path, out: &Path) {
+    let input = FrameSource { frames: Some(frames.to_path_buf()), ..FrameSource::default() };
+    track_face(&FaceTrackSettings { input, out: out.to_path_buf(), ..FaceTrackSettings::default() }).unwrap();
 }
 
 fn picture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../mannequin-fit/tests/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -282,7 +283,7 @@ fn main() {
     let mut one_image = Vec::new();
     for name in ["astronaut.png", "grace_hopper.jpg", "camera.png"] {
         let out = dir.join(name);
-        mannequin(&["face", "fit", "--image", s(&picture(name)), "--out", s(&out)]).unwrap();
+        face_fit(&picture(name), &out).unwrap();
         let report = json(&out.join("fit.json"));
         let seconds = report["seconds"].as_f64().unwrap();
         one_image.push(seconds);
@@ -312,7 +313,7 @@ fn main() {
             let picture = scene.render(&truth);
             picture.write_png(&path).unwrap();
             let out = dir.join(format!("synthetic_{size}_{k}"));
-            if let Err(e) = mannequin(&["face", "fit", "--image", s(&path), "--out", s(&out)]) {
+            if let Err(e) = face_fit(&path, &out) {
                 misses.push(e);
                 continue;
             }
@@ -403,7 +404,7 @@ fn main() {
         truths.push(truth);
     }
     let out = dir.join("clip_track");
-    mannequin(&["face", "track", "--frames", s(&clip), "--out", s(&out)]).unwrap();
+    face_track(&clip, &out);
     let report = json(&out.join("track.json"));
     let shape = floats(&report["shape"]);
     let mut errors = Vec::new();
