@@ -17,7 +17,7 @@ use glam::DVec3;
 use mannequin_body::BodyModel;
 use mannequin_data::{Camera, Dataset, Poses};
 use mannequin_fit::body_fit::{Fitter, assumed_focal};
-use mannequin_fit::capture::{Tracker, fit_clip, resolve_mirrors};
+use mannequin_fit::clip_fit::{Tracker, fit_clip, resolve_mirrors};
 use mannequin_fit::rigid_alignment::best_rotation;
 use mannequin_fit::{PersonModels, fit_body};
 use mannequin_synth::{SynthOptions, generate};

@@ -17,14 +17,14 @@ use std::path::{Path, PathBuf};
 use glam::{DQuat, DVec3};
 use mannequin_body::{BodyModel, FaceModel};
 use mannequin_data::Image;
-use mannequin_io::rng::SplitMix64;
 use mannequin_fit::body_fit::picture_camera;
 use mannequin_fit::face_landmark_table::FaceLandmarkTable;
 use mannequin_fit::face_photo::fit_face_photo;
-use mannequin_fit::frame_source::FrameSource;
-use mannequin_fit::{FaceTrackSettings, FitSettings, track_face};
 use mannequin_fit::face_render::{LitHead, render_head};
+use mannequin_fit::frame_source::FrameSource;
 use mannequin_fit::rigid_alignment::best_rotation;
+use mannequin_fit::{FaceTrackSettings, FitSettings, track_face};
+use mannequin_io::rng::SplitMix64;
 use mannequin_mesh::read_obj;
 
 #[path = "../../../tools/bench_args.rs"]

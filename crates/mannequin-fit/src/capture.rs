@@ -1,383 +1,249 @@
-//! A clip to one person's landmarks and body per frame. The person is found in the first frame
-//! and followed as MediaPipe follows them (the next crop from this frame's auxiliary points),
-//! found again where the landmarker loses them.
-//!
-//! Seen from the side or behind, the landmarker sometimes reads the person as their mirror (left
-//! and right swapped, depth turned over); the clip's turn decides which frames those are
-//! ([`resolve_mirrors`]). Then the body is fitted to the whole clip, with one shape:
-//! 1. a starting shape, the median of independent fits on a few frames spread over the clip;
-//! 2. a forward pass: each frame's pose starts from the previous frame's and is pulled toward
-//!    it, and its orientation toward where the clip's landmarks say it faces;
-//! 3. the shape refitted to many frames' residuals at once, their poses held;
-//! 4. a backward pass with that shape, each frame pulled toward both its neighbours.
+//! A person's own video to a dataset `mannequin train` reads (`mannequin capture`, the
+//! PeopleSnapshot layout): frames, the person's masks, one static camera (the person turns in
+//! front of it, as in PeopleSnapshot) and the body fitted in every frame ([`crate::clip_fit`]),
+//! plus an overlay per frame to check the fit by. A checkpoint every few frames and after each
+//! fit pass lets a stopped capture resume; a finished one removes it.
 
-use glam::{DQuat, DVec3};
-use mannequin_body::rodrigues::{axis_angle_quat, quat_axis_angle};
-use mannequin_data::Image;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-use crate::body_fit::{Anchor, BodyFit, Fitter, FramePose, rotation_gap};
-use crate::crop::RotatedRect;
+use mannequin_body::BodyModel;
+use mannequin_data::{DatasetWriter, Frame, Image};
+use mannequin_io::progress::bar;
+
+use crate::body_fit::{BodyFit, Fitter};
+use crate::capture_checkpoint::{CaptureRun, Saved, read_checkpoint, write_checkpoint};
+use crate::capture_dataset::write_dataset;
+use crate::clip_fit::{ClipFit, Tracker, resolve_mirrors};
 use crate::error::FitError;
-use crate::person_models::{PersonModels, pick_person};
+use crate::fit_check::{check_picture, posed_mesh};
+use crate::fit_settings::FitSettings;
+use crate::frame_source::{FrameSource, Frames};
+use crate::output::{CHECKPOINT, create_dir, write_report};
+use crate::person_models::PersonModels;
 use crate::pose_landmarker::PoseLandmarks;
 
-/// Frames fitted independently to find the clip's one shape.
-const SHAPE_FRAMES: usize = 8;
-/// How hard each frame's pose is pulled toward the previous frame's, per radian (the landmark
-/// term counts 1 per 1 % of the person's crop).
-const SMOOTHNESS: f64 = 2.0;
-/// Frames, spread over the clip, whose residuals the clip's one shape is fitted to.
-const SHAPE_REFIT_FRAMES: usize = 24;
-/// Passes of the joint refinement after the first, forward one, alternately backward and
-/// forward: each frame is refitted pulled toward the mean of its two neighbours (Gauss–Seidel
-/// on the clip's smoothness), so later frames inform earlier ones too.
-const SWEEPS: usize = 1;
-/// How hard each frame's orientation is pulled toward where the clip's landmarks say it faces,
-/// per radian.
-const FACING: f64 = 3.0;
-/// Frames either side whose facings vote on each frame's.
-const FACING_WINDOW: usize = 5;
+/// Frames tracked between checkpoints.
+const CHECKPOINT_EVERY: usize = 10;
 
-/// What reading a frame as its landmarker's mirror costs, in radians of turn between frames:
-/// a few frames' mirrors are undone, a long run of them is left as read.
-const MIRROR_COST: f64 = 0.25;
+/// Everything a capture reads: its frames, the body and camera, and where it writes.
+#[derive(Clone, Debug, Default, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
+pub struct CaptureSettings {
+    #[command(flatten)]
+    pub input: FrameSource,
+    #[command(flatten)]
+    pub fitting: FitSettings,
+    /// The dataset folder to write. A capture that was stopped resumes from its checkpoint there.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The person stands still and the camera moves: write the body held where the first frame
+    /// has it and a camera per frame (the same fit, seen the other way) instead of one static
+    /// camera and the body turning in front of it.
+    #[arg(long)]
+    pub moving_camera: bool,
+    /// Ignore a checkpoint in --out and start over.
+    #[arg(long)]
+    pub restart: bool,
+}
 
-/// Undoes the landmarker's mirror readings (`PoseLandmarks::mirrored`) where the clip's turn
-/// says they are mirrors: each frame is read as given or mirrored, whichever sequence turns the
-/// body least from frame to frame, mirrors counted at [`MIRROR_COST`] each (a two-state
-/// Viterbi). Returns the frames that were mirrored.
-pub fn resolve_mirrors(fitter: &Fitter, people: &mut [PoseLandmarks]) -> Vec<usize> {
-    let n = people.len();
-    let facings: Vec<[Option<DQuat>; 2]> =
-        people.iter().map(|p| [fitter.facing(p), fitter.facing(&p.mirrored())]).collect();
-    let turn = |a: Option<DQuat>, b: Option<DQuat>| match (a, b) {
-        (Some(a), Some(b)) => rotation_gap(a, b).length(),
-        _ => 0.0,
+/// How a capture went, for the closing line.
+pub struct CaptureSummary {
+    pub kept: usize,
+    pub left_out: usize,
+}
+
+/// Captures, and where the run fails before its first checkpoint, removes the output folder it
+/// made: nothing half-made is left to mistake for a dataset. A run with a checkpoint keeps its
+/// folder, so that running it again resumes.
+pub fn capture(settings: &CaptureSettings) -> Result<CaptureSummary, FitError> {
+    let fresh = !settings.out.exists();
+    let result = capture_into(settings);
+    if result.is_err() && fresh && !settings.out.join(CHECKPOINT).exists() {
+        let _ = std::fs::remove_dir_all(&settings.out);
+    }
+    result
+}
+
+fn capture_into(settings: &CaptureSettings) -> Result<CaptureSummary, FitError> {
+    let start = Instant::now();
+    let out = &settings.out;
+    settings.fitting.check()?;
+    let Frames { dir, files, decoded } = settings.input.frames(out)?;
+    if files.len() < 2 {
+        return Err(FitError::input(
+            dir.display().to_string(),
+            format!("{} frame(s); a capture needs at least 2", files.len()),
+        ));
+    }
+    same_size(&files)?;
+    let run = CaptureRun {
+        source: settings.input.fingerprint(&files)?,
+        fps: settings.input.fps,
+        max_frames: settings.input.max_frames,
+        body: settings.fitting.body.clone(),
+        focal: settings.fitting.focal,
     };
-    let mut cost = [0.0, MIRROR_COST];
-    let mut back = vec![[0usize; 2]; n];
-    for i in 1..n {
-        let mut next = [0.0; 2];
-        for s in 0..2 {
-            let (best, from) = (0..2)
-                .map(|t| (cost[t] + turn(facings[i - 1][t], facings[i][s]), t))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .expect("two states");
-            next[s] = best + s as f64 * MIRROR_COST;
-            back[i][s] = from;
-        }
-        cost = next;
+    create_dir(out)?;
+    let checkpoint = out.join(CHECKPOINT);
+    let mut saved = if !settings.restart && checkpoint.exists() {
+        let saved = read_checkpoint(&checkpoint, &run, out)?;
+        tracing::info!(
+            "resuming {} ({} of {} frames tracked, {} fit passes done)",
+            checkpoint.display(),
+            saved.tracked,
+            files.len(),
+            saved.fit.passes
+        );
+        saved
+    } else {
+        Saved::default()
+    };
+    let model = settings.fitting.body_model()?;
+    let models = PersonModels::load()?;
+    track(&models, &files, out, &checkpoint, &run, &mut saved)?;
+    let (width, height) = (saved.kept[0].1.width, saved.kept[0].1.height);
+    let focal = settings.fitting.focal(width, height)?;
+    let fitter = Fitter::new(&model, width, height, focal)?;
+    // The fit reads the landmarks with the mirrors undone; the checkpoint keeps them as read.
+    let mut people_read = saved.people.clone();
+    let mirrored = resolve_mirrors(&fitter, &mut people_read);
+    let mut clip = ClipFit::new(&fitter, &people_read, std::mem::take(&mut saved.fit))?;
+    let progress = bar(ClipFit::steps(people_read.len()) as u64, "body fit");
+    progress.set_position(clip.steps_done() as u64);
+    while clip.next_pass(&mut || progress.inc(1))? {
+        saved.fit = clip.progress.clone();
+        write_checkpoint(&checkpoint, &run, &saved)?;
     }
-    let mut state = if cost[1] < cost[0] { 1 } else { 0 };
-    let mut mirrored = Vec::new();
-    for i in (0..n).rev() {
-        if state == 1 {
-            people[i] = people[i].mirrored();
-            mirrored.push(i);
-        }
-        state = back[i][state];
+    progress.finish();
+    let fits = clip.fits()?;
+    let Saved { kept, skipped, .. } = &saved;
+    write_dataset(out, &model, &fits, settings.moving_camera)?;
+    let ious = write_overlays(out, &model, kept, &people_read, &fits)?;
+    if decoded {
+        std::fs::remove_dir_all(&dir).map_err(FitError::file("removing", &dir))?;
     }
-    mirrored.reverse();
-    mirrored
+    let report = report(kept, &fits, &ious, skipped, &mirrored, focal, start.elapsed().as_secs_f64());
+    write_report(&out.join("capture.json"), &report)?;
+    std::fs::remove_file(&checkpoint).map_err(FitError::file("removing", &checkpoint))?;
+    Ok(CaptureSummary { kept: kept.len(), left_out: skipped.len() })
 }
 
-/// Each frame's facing, voted on by its neighbours: the one of the window's facings nearest to
-/// all the others (a medoid). A landmarker that turns the person round for a few frames, or a
-/// side view it reads the wrong way, is outvoted; a steady turn keeps its own frame's facing.
-fn voted_facings(facings: &[Option<DQuat>]) -> Vec<Option<DQuat>> {
-    (0..facings.len())
-        .map(|i| {
-            let window =
-                &facings[i.saturating_sub(FACING_WINDOW)..(i + FACING_WINDOW + 1).min(facings.len())];
-            let spread =
-                |q: DQuat| window.iter().flatten().map(|&o| rotation_gap(q, o).length()).sum::<f64>();
-            window.iter().flatten().copied().min_by(|&a, &b| spread(a).total_cmp(&spread(b)))
-        })
-        .collect()
-}
-
-/// Follows one person from frame to frame.
-pub struct Tracker<'a> {
-    models: &'a PersonModels,
-    /// Where the last frame's landmarks put the person next.
-    next_roi: Option<RotatedRect>,
-}
-
-impl<'a> Tracker<'a> {
-    pub fn new(models: &'a PersonModels) -> Self {
-        Self::resume(models, None)
-    }
-
-    /// A tracker that goes on where one stopped: `next_roi` is the last frame's next crop (None
-    /// when the person was not in it).
-    pub fn resume(models: &'a PersonModels, next_roi: Option<RotatedRect>) -> Self {
-        Self { models, next_roi }
-    }
-
-    /// The person's landmarks in the next frame; None when nobody is there.
-    pub fn next(&mut self, image: &Image) -> Result<Option<PoseLandmarks>, FitError> {
-        let followed = match self.next_roi {
-            Some(roi) => self.models.follow(image, roi)?,
-            None => None,
-        };
-        let found = match followed {
-            Some(l) => Some(l),
-            None => {
-                let everyone = self.models.people(image)?;
-                match everyone.is_empty() {
-                    true => None,
-                    false => {
-                        Some(self.models.refine(image, pick_person(&everyone, None)?.landmarks.clone())?)
-                    }
-                }
-            }
-        };
-        self.next_roi = found.as_ref().map(|l| l.next_roi);
-        Ok(found)
-    }
-}
-
-/// How far a clip's fit has got: the passes done, the clip's shape and each frame's pose and
-/// placement after the last of them. A job stores it between passes to resume.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ClipProgress {
-    pub passes: usize,
-    pub betas: Vec<f32>,
-    pub frames: Vec<FramePose>,
-}
-
-/// The passes of a clip's fit (see the module's list), one at a time.
-pub struct ClipFit<'a> {
-    fitter: &'a Fitter,
-    people: &'a [PoseLandmarks],
-    facings: Vec<Option<(DQuat, f64)>>,
-    pub progress: ClipProgress,
-}
-
-impl<'a> ClipFit<'a> {
-    /// Passes in all: the forward pass (with the starting shape), the shape, the sweeps.
-    pub const PASSES: usize = 2 + SWEEPS;
-
-    /// A fit of `people` (one per frame) that starts after `progress` (default: from scratch).
-    pub fn new(
-        fitter: &'a Fitter,
-        people: &'a [PoseLandmarks],
-        progress: ClipProgress,
-    ) -> Result<Self, FitError> {
-        let n = people.len();
-        if n == 0 {
-            return Err(FitError::input("clip", "no frames to fit"));
-        }
-        if progress.passes > 0 && progress.frames.len() != n {
+/// Refuses a clip whose frames differ in size, from their headers, before any work.
+fn same_size(files: &[PathBuf]) -> Result<(), FitError> {
+    let first = Image::read_size(&files[0])?;
+    for file in &files[1..] {
+        let size = Image::read_size(file)?;
+        if size != first {
             return Err(FitError::input(
-                "clip",
-                format!("a fit of {} frames cannot go on with {n}", progress.frames.len()),
+                file.display().to_string(),
+                format!(
+                    "{}×{}, but the clip's first frame ({}) is {}×{}",
+                    size.0,
+                    size.1,
+                    files[0].display(),
+                    first.0,
+                    first.1
+                ),
             ));
         }
-        let facings = voted_facings(&people.iter().map(|p| fitter.facing(p)).collect::<Vec<_>>())
-            .into_iter()
-            .map(|q| q.map(|q| (q, FACING)))
-            .collect();
-        Ok(Self { fitter, people, facings, progress })
     }
-
-    /// Progress steps per pass: frames fitted (or one for the shape).
-    pub fn steps(frames: usize) -> usize {
-        SHAPE_FRAMES.min(frames) + (1 + SWEEPS) * frames + 1
-    }
-
-    /// Progress steps the passes done so far took.
-    pub fn steps_done(&self) -> usize {
-        let n = self.people.len();
-        let passes = self.progress.passes;
-        let forward = if passes > 0 { SHAPE_FRAMES.min(n) + n } else { 0 };
-        forward + usize::from(passes > 1) + passes.saturating_sub(2) * n
-    }
-
-    /// Runs the next pass, calling `step` after each fit; false when all are done.
-    pub fn next_pass(&mut self, step: &mut dyn FnMut()) -> Result<bool, FitError> {
-        match self.progress.passes {
-            0 => self.forward(step)?,
-            1 => self.refit_shape(step)?,
-            p if p < Self::PASSES => self.sweep(p - 2, step)?,
-            _ => return Ok(false),
-        }
-        self.progress.passes += 1;
-        Ok(true)
-    }
-
-    /// Every frame's fit as it stands.
-    pub fn fits(&self) -> Result<Vec<BodyFit>, FitError> {
-        let ClipProgress { betas, frames, .. } = &self.progress;
-        self.people.iter().zip(frames).map(|(person, frame)| self.fitter.at(person, betas, frame)).collect()
-    }
-
-    /// A starting shape, the median of independent fits spread over the clip; then each frame
-    /// from the previous one.
-    fn forward(&mut self, step: &mut dyn FnMut()) -> Result<(), FitError> {
-        let (fitter, people) = (self.fitter, self.people);
-        let n = people.len();
-        let count = SHAPE_FRAMES.min(n);
-        let mut shapes = Vec::with_capacity(count);
-        let mut previous = None;
-        for i in (0..count).map(|k| k * n / count) {
-            let fit = fitter.fit(&people[i])?;
-            shapes.push(fit.betas.clone());
-            previous.get_or_insert(fit.frame_pose());
-            step();
-        }
-        let betas: Vec<f32> = (0..shapes[0].len())
-            .map(|k| {
-                let mut v: Vec<f32> = shapes.iter().map(|b| b[k]).collect();
-                v.sort_by(f32::total_cmp);
-                v[v.len() / 2]
-            })
-            .collect();
-        let mut previous = previous.expect("frame 0 is fitted first");
-        let mut frames = Vec::with_capacity(n);
-        for (i, person) in people.iter().enumerate() {
-            let weight = if i == 0 { 0.0 } else { SMOOTHNESS };
-            let anchor = Anchor { at: &previous, weight, facing: self.facings[i] };
-            previous = fitter.follow(person, &betas, &anchor)?.frame_pose();
-            frames.push(previous.clone());
-            step();
-        }
-        self.progress = ClipProgress { passes: self.progress.passes, betas, frames };
-        Ok(())
-    }
-
-    /// The shape refitted to frames spread over the clip at once, their poses held.
-    fn refit_shape(&mut self, step: &mut dyn FnMut()) -> Result<(), FitError> {
-        let n = self.people.len();
-        let count = SHAPE_REFIT_FRAMES.min(n);
-        let held: Vec<_> =
-            (0..count).map(|k| k * n / count).map(|i| (&self.people[i], &self.progress.frames[i])).collect();
-        self.progress.betas = self.fitter.fit_shape(&held, &self.progress.betas)?;
-        step();
-        Ok(())
-    }
-
-    /// Each frame refitted pulled toward its neighbours; backward on even sweeps.
-    fn sweep(&mut self, sweep: usize, step: &mut dyn FnMut()) -> Result<(), FitError> {
-        let n = self.people.len();
-        let order: Box<dyn Iterator<Item = usize>> =
-            if sweep.is_multiple_of(2) { Box::new((0..n).rev()) } else { Box::new(0..n) };
-        for i in order {
-            let frames = &self.progress.frames;
-            let neighbours: Vec<&FramePose> = [i.checked_sub(1), Some(i + 1).filter(|&j| j < n)]
-                .into_iter()
-                .flatten()
-                .map(|j| &frames[j])
-                .collect();
-            let target = between(&frames[i], &neighbours);
-            let weight = SMOOTHNESS * (neighbours.len() as f64).sqrt();
-            let anchor = Anchor { at: &target, weight, facing: self.facings[i] };
-            self.progress.frames[i] =
-                self.fitter.follow(&self.people[i], &self.progress.betas, &anchor)?.frame_pose();
-            step();
-        }
-        Ok(())
-    }
+    Ok(())
 }
 
-/// The body in every frame of a clip, with one shape, all passes at once; `step` is called
-/// after each fit.
-pub fn fit_clip(
-    fitter: &Fitter,
-    people: &[PoseLandmarks],
-    step: &mut dyn FnMut(),
-) -> Result<Vec<BodyFit>, FitError> {
-    let mut clip = ClipFit::new(fitter, people, ClipProgress::default())?;
-    while clip.next_pass(step)? {}
-    clip.fits()
-}
-
-/// The pose and placement midway between a frame's neighbours: the mean of their joint
-/// rotations and translations, and of their orientations taken about the frame's own.
-fn between(own: &FramePose, neighbours: &[&FramePose]) -> FramePose {
-    let k = neighbours.len() as f32;
-    let mut pose: Vec<f32> =
-        (0..own.pose.len()).map(|j| neighbours.iter().map(|f| f.pose[j]).sum::<f32>() / k).collect();
-    let q = |f: &FramePose| axis_angle_quat([f.pose[0], f.pose[1], f.pose[2]]).as_dquat();
-    let gap = neighbours.iter().map(|f| rotation_gap(q(own), q(f))).sum::<DVec3>() / k as f64;
-    let turned = axis_angle_quat(gap.as_vec3().to_array()).as_dquat() * q(own);
-    pose[..3].copy_from_slice(&quat_axis_angle(turned.as_quat()));
-    let transl = std::array::from_fn(|c| neighbours.iter().map(|f| f.transl[c]).sum::<f32>() / k);
-    FramePose { pose, transl }
-}
-
-#[cfg(test)]
-mod tests {
-    use glam::Vec3;
-    use mannequin_body::BodyModel;
-    use mannequin_body::smpl_joint::{L_HIP, L_SHOULDER, R_HIP, R_SHOULDER};
-
-    use super::*;
-    use crate::blazepose::{LEFT_HIP, LEFT_SHOULDER, RIGHT_HIP, RIGHT_SHOULDER};
-    use crate::crop::RotatedRect;
-    use crate::pose_landmarker::NUM_LANDMARKS;
-
-    /// World landmarks of the rest body's hips and shoulders turned `yaw` about the vertical, in
-    /// the camera's axes (y down, z away); nothing else.
-    fn turned_torso(model: &BodyModel, yaw: f32) -> PoseLandmarks {
-        let joints = mannequin_body::forward(model, &[], &[0.0; 72], &[0.0; 3]).unwrap().joints;
-        let turn = glam::Quat::from_rotation_y(yaw);
-        let at = |j: usize| {
-            let p = turn * Vec3::from_slice(&joints[3 * j..3 * j + 3]);
-            [p.x, -p.y, -p.z]
-        };
-        let mut world = vec![[0.0; 3]; NUM_LANDMARKS];
-        let mut visibility = vec![0.0; NUM_LANDMARKS];
-        for (i, j) in
-            [(LEFT_HIP, L_HIP), (RIGHT_HIP, R_HIP), (LEFT_SHOULDER, L_SHOULDER), (RIGHT_SHOULDER, R_SHOULDER)]
-        {
-            world[i] = at(j);
-            visibility[i] = 1.0;
-        }
-        let square = RotatedRect { cx: 0.0, cy: 0.0, width: 1.0, height: 1.0, rotation: 0.0 };
-        PoseLandmarks {
-            roi: square,
-            flag: 1.0,
-            points: vec![[0.0; 3]; NUM_LANDMARKS],
-            visibility,
-            presence: vec![1.0; NUM_LANDMARKS],
-            world,
-            next_roi: square,
-            mask: Vec::new(),
-        }
+/// Each frame's image and the person's landmarks, from where `saved` left off; frames where nobody
+/// is found are left out and named. Each kept frame's image and mask go into the dataset as it
+/// comes, and a checkpoint every few frames.
+fn track(
+    models: &PersonModels,
+    files: &[PathBuf],
+    out: &Path,
+    checkpoint: &Path,
+    run: &CaptureRun,
+    saved: &mut Saved,
+) -> Result<(), FitError> {
+    let writer = DatasetWriter::new(out);
+    for sub in ["images", "masks", "poses"] {
+        create_dir(&out.join(sub))?;
     }
-
-    #[test]
-    fn a_few_mirrored_frames_of_a_turn_are_found_and_undone() {
-        let model = BodyModel::default_body();
-        let fitter = Fitter::new(&model, 64, 64, 64.0).unwrap();
-        // Half a turn in 40 frames. A mirror turns the body from ψ to π − ψ, so it shows most
-        // facing the camera or away (frames 3, 4 and 36) and less at three quarters (28–30); in
-        // profile (frame 20) it is the same reading.
-        let truth: Vec<PoseLandmarks> = (0..40).map(|i| turned_torso(&model, 0.08 * i as f32)).collect();
-        let mut people = truth.clone();
-        let misread = [3, 4, 28, 29, 30, 36];
-        for &i in &misread {
-            people[i] = people[i].mirrored();
-        }
-        assert_eq!(resolve_mirrors(&fitter, &mut people), misread);
-        for (got, want) in people.iter().zip(&truth) {
-            for (a, b) in got.world.iter().zip(&want.world) {
-                assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6));
+    let progress = bar(files.len() as u64, "landmarks");
+    progress.set_position(saved.tracked as u64);
+    let last_kept = saved.kept.last().map(|(f, _)| f);
+    let followed = (saved.tracked > 0 && last_kept == Some(&files[saved.tracked - 1]))
+        .then(|| saved.people.last().map(|l| l.next_roi))
+        .flatten();
+    let mut tracker = Tracker::resume(models, followed);
+    for (i, file) in files.iter().enumerate().skip(saved.tracked) {
+        let image = Image::read(file)?;
+        match tracker.next(&image).map_err(|e| FitError::within(file.display().to_string(), e))? {
+            Some(l) => {
+                let mask = l.person_mask(image.width, image.height);
+                let frame = Frame { index: saved.kept.len(), image, mask, normals: None, depth: None };
+                writer.write_frame(&frame)?;
+                saved.people.push(l);
+                saved.kept.push((file.clone(), frame.image));
             }
+            None => saved.skipped.push(file.clone()),
         }
-        // Read as given, a steady turn is left alone.
-        assert!(resolve_mirrors(&fitter, &mut truth.clone()).is_empty());
+        saved.tracked = i + 1;
+        if saved.tracked.is_multiple_of(CHECKPOINT_EVERY) && saved.tracked < files.len() {
+            write_checkpoint(checkpoint, run, saved)?;
+        }
+        progress.inc(1);
     }
+    progress.finish();
+    if saved.kept.len() < 2 {
+        return Err(FitError::Picture(format!(
+            "the person was found in {} of {} frames; a capture needs at least 2",
+            saved.kept.len(),
+            files.len()
+        )));
+    }
+    write_checkpoint(checkpoint, run, saved)
+}
 
-    #[test]
-    fn the_rotation_gap_is_the_short_way_round() {
-        let from = DQuat::from_rotation_y(3.0);
-        let to = DQuat::from_rotation_y(-3.0);
-        // 3 rad one way and −3 the other are 2π − 6 ≈ 0.283 rad apart, through half a turn.
-        let gap = rotation_gap(from, to);
-        assert!((gap - DVec3::new(0.0, std::f64::consts::TAU - 6.0, 0.0)).length() < 1e-9, "{gap}");
-        let q = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 2.0).normalize(), 0.7);
-        assert!((rotation_gap(DQuat::IDENTITY, q) - DVec3::new(1.0, 2.0, 2.0) / 3.0 * 0.7).length() < 1e-9);
+/// `overlay/frame_%04d.png` for checking each frame's fit; the IoU of each body silhouette with
+/// the person's mask.
+fn write_overlays(
+    out: &Path,
+    model: &BodyModel,
+    kept: &[(PathBuf, Image)],
+    people: &[PoseLandmarks],
+    fits: &[BodyFit],
+) -> Result<Vec<f64>, FitError> {
+    let dir = out.join("overlay");
+    create_dir(&dir)?;
+    let progress = bar(kept.len() as u64, "overlays");
+    let mut ious = Vec::with_capacity(kept.len());
+    for (i, (((_, image), person), fit)) in kept.iter().zip(people).zip(fits).enumerate() {
+        let (picture, iou) = check_picture(image, &posed_mesh(model, fit)?, person, fit);
+        picture.write_png(&dir.join(format!("frame_{i:04}.png")))?;
+        ious.push(iou);
+        progress.inc(1);
     }
+    progress.finish();
+    Ok(ious)
+}
+
+fn report(
+    kept: &[(PathBuf, Image)],
+    fits: &[BodyFit],
+    ious: &[f64],
+    skipped: &[PathBuf],
+    mirrored: &[usize],
+    focal: f64,
+    seconds: f64,
+) -> serde_json::Value {
+    serde_json::json!({
+        "frames": kept.iter().zip(fits).zip(ious).map(|(((file, _), f), iou)| serde_json::json!({
+            "source": file.display().to_string(),
+            "median_landmark_error_px": f.median_error_px(),
+            "mask_iou": iou,
+        })).collect::<Vec<_>>(),
+        "mean_mask_iou": ious.iter().sum::<f64>() / ious.len() as f64,
+        "left_out": skipped.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+        "read_mirrored": mirrored.iter().map(|&i| kept[i].0.display().to_string()).collect::<Vec<_>>(),
+        "betas": fits[0].betas,
+        "focal_px": focal,
+        "seconds": seconds,
+    })
 }

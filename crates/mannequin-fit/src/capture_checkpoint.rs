@@ -12,7 +12,7 @@ use mannequin_io::run_record::{check_run, write_run};
 use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::body_fit::FramePose;
-use crate::capture::ClipProgress;
+use crate::clip_fit::ClipProgress;
 use crate::crop::RotatedRect;
 use crate::error::FitError;
 use crate::pose_landmarker::{NUM_LANDMARKS, PoseLandmarks};
