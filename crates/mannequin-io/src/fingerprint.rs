@@ -82,13 +82,8 @@ mod tests {
     /// The serialised form is stored in training checkpoints: its field names must not change.
     #[test]
     fn serialises_under_the_names_checkpoints_hold() {
-        let f = Fingerprint {
-            files: 3,
-            bytes: 42,
-            listing: "a".into(),
-            cameras: "b".into(),
-            poses: "c".into(),
-        };
+        let f =
+            Fingerprint { files: 3, bytes: 42, listing: "a".into(), cameras: "b".into(), poses: "c".into() };
         let json = serde_json::to_string(&f).unwrap();
         assert_eq!(json, r#"{"files":3,"bytes":42,"listing":"a","cameras":"b","poses":"c"}"#);
     }

@@ -13,10 +13,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use mannequin_mesh::kdtree::KdTree;
 use super::surface_distance::TriangleBvh;
 use super::surface_sampling::{SurfaceSamples, sample_surface};
 use mannequin_mesh::TriMesh;
+use mannequin_mesh::kdtree::KdTree;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GeometryMetrics {
