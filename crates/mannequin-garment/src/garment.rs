@@ -10,8 +10,8 @@ use mannequin_mesh::{ClosestPoint, SurfacePoint, TriMesh, UvLayout};
 use serde::{Deserialize, Serialize};
 
 use crate::category::Category;
-use crate::error::GarmentError;
 use crate::ease::Ease;
+use crate::error::GarmentError;
 
 /// How the template was made: enough to make it again on another body model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

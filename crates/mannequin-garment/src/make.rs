@@ -12,8 +12,8 @@ use mannequin_mesh::remesh::remesh;
 use mannequin_mesh::{ClosestPoint, TriMesh, UvLayout};
 
 use crate::category::Category;
-use crate::error::GarmentError;
 use crate::ease::Ease;
+use crate::error::GarmentError;
 use crate::garment::{Garment, Recipe, check_edge_length};
 use crate::region::{Landmarks, covered_region, open_front};
 use crate::sewing::sew_skirt;

@@ -56,3 +56,21 @@ impl Default for SimulateSettings {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::*;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        settings: SimulateSettings,
+    }
+
+    #[test]
+    fn the_command_line_defaults_are_the_settings_defaults() {
+        assert_eq!(Cli::parse_from(["mannequin"]).settings, SimulateSettings::default());
+    }
+}
