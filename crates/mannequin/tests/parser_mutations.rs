@@ -6,7 +6,9 @@
 //! during a parse by a multiple of the input length). A hang has no timer here: the readers check
 //! every count against the bytes left before looping by it, so a regression shows as a test that
 //! never ends. The stable-toolchain stand-in for `cargo +nightly fuzz run` (see `fuzz/`); it
-//! lives in this crate because this crate depends on every reader.
+//! lives in the command line's crate because that crate depends on every reader: images and label
+//! maps (data), `.garment` files (garment) and checkpoints (cloth, avatar) as well as the arrays,
+//! meshes, motions, splats and cameras below them.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -15,9 +17,11 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 
 use mannequin_body::{Motion, parse_model};
-use mannequin_io::rng::SplitMix64;
-use mannequin_io::Npz;
+use mannequin_data::Image;
+use mannequin_data::labels::LabelMap;
 use mannequin_io::npy::parse_npy;
+use mannequin_io::rng::SplitMix64;
+use mannequin_io::{NpyArray, Npz, NpzWriter};
 use mannequin_mesh::Obj;
 use mannequin_splat::{SplatScene, parse_camera_json};
 
@@ -86,9 +90,11 @@ fn peak_bytes<R>(f: impl FnOnce() -> R) -> (R, usize) {
 
 /// What a reader may hold for an input of `len` bytes: decoding widens values (a `uint8` index
 /// list becomes `u32` triangles, an `|S1` string a `String`), so a fixed multiple, plus a
-/// constant for the zip reader's and the JSON parser's own tables.
+/// constant for the zip reader's and the JSON parser's own tables (the zip reader sizes its table
+/// of entries by the count an end record declares, at most 65,535, before reading them: about
+/// 420 KB for a small archive whose central directory was copied over its start).
 fn allowance(len: usize) -> usize {
-    64 * len + (128 << 10)
+    64 * len + (512 << 10)
 }
 
 /// Mutated cases per reader, spread evenly over its seeds.
@@ -176,11 +182,25 @@ fn mutate(b: &mut Vec<u8>, rng: &mut SplitMix64) -> String {
     }
 }
 
-/// Runs `read` on [`CASES`] mutations (one to three each) of the seeds of `target`, after checking
-/// that every seed itself reads.
+/// Runs `read` on [`CASES`] mutations of the seeds of `target`, within [`allowance`].
 fn mutations(target: &str, read: impl Fn(&[u8]) -> Result<(), String>) {
-    let seeds = corpus(target);
-    for (path, bytes) in &seeds {
+    mutations_of(target, &corpus(target), allowance, read);
+}
+
+/// [`mutations`] with another bound on the bytes a case may hold.
+fn mutations_within(target: &str, most: usize, read: impl Fn(&[u8]) -> Result<(), String>) {
+    mutations_of(target, &corpus(target), |len| allowance(len).max(most), read);
+}
+
+/// Runs `read` on [`CASES`] mutations (one to three each) of `seeds`, after checking that every
+/// seed itself reads, holding each case to `limit` of its length in bytes.
+fn mutations_of(
+    target: &str,
+    seeds: &[(PathBuf, Vec<u8>)],
+    limit: impl Fn(usize) -> usize,
+    read: impl Fn(&[u8]) -> Result<(), String>,
+) {
+    for (path, bytes) in seeds {
         read(bytes).unwrap_or_else(|e| panic!("seed {} does not read: {e}", path.display()));
     }
     let mut ok = 0;
@@ -193,7 +213,7 @@ fn mutations(target: &str, read: impl Fn(&[u8]) -> Result<(), String>) {
         let (result, peak) = peak_bytes(|| catch_unwind(AssertUnwindSafe(|| read(&bytes))));
         let result = result.unwrap_or_else(|_| panic!("{}: the reader panicked", report()));
         assert!(
-            peak <= allowance(bytes.len()),
+            peak <= limit(bytes.len()),
             "{}: {peak} bytes live for {} bytes of input",
             report(),
             bytes.len()
@@ -317,3 +337,111 @@ fn camera_json() {
         parse_camera_json(Path::new("case.json"), b).map(drop).map_err(|e| e.to_string())
     });
 }
+
+/// Runs `read` on the bytes written to a file of this thread's own, for readers that take a path.
+fn via_file(name: &str, bytes: &[u8], read: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("parser_mutations");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{:?}-{name}", std::thread::current().id()).replace(['(', ')'], ""));
+    std::fs::write(&path, bytes).unwrap();
+    read(&path)
+}
+
+/// What an image reader may hold: the pixels a header declares are legitimately allocated before
+/// the data proves them (a PNG of one colour compresses to almost nothing), so the bound is the
+/// decoded image at the pixel limit, as `f32` RGB plus the decoder's RGBA buffer.
+const IMAGE_ALLOWANCE: usize = mannequin_io::limits::MAX_IMAGE_PIXELS * (12 + 4);
+
+#[test]
+fn images() {
+    mutations_within("image", IMAGE_ALLOWANCE, |b| {
+        Image::decode(Path::new("case.png"), b).map(drop).map_err(|e| e.to_string())
+    });
+}
+
+#[test]
+fn label_maps() {
+    mutations_within("label_map", IMAGE_ALLOWANCE, |b| {
+        via_file("labels.png", b, |p| {
+            LabelMap::read_png_with_legend(p, 3).map(drop).map_err(|e| e.to_string())
+        })
+    });
+}
+
+#[test]
+fn garments() {
+    mutations("garment", |b| {
+        via_file("case.garment", b, |p| {
+            mannequin_garment::file::read_garment(p).map(drop).map_err(|e| e.to_string())
+        })
+    });
+}
+
+/// The record a cloth run's checkpoint carries, as the simulating commands write one.
+#[derive(serde::Serialize)]
+struct ClothRun {
+    material: String,
+    substeps: u32,
+    frames: usize,
+}
+
+/// A cloth simulation's checkpoint (its record, state and frames so far) and the training
+/// checkpoint's record and counters: written by the writers, then mutated.
+#[test]
+fn checkpoints() {
+    use mannequin_cloth::run_checkpoint::{add_state, check_run, frames_array, read_frames, read_state};
+    let run = ClothRun { material: "cotton".into(), substeps: 20, frames: 2 };
+    let state = mannequin_cloth::ClothState {
+        positions: vec![[0.0, 1.0, 0.0], [0.1, 1.0, 0.0], [0.0, 1.1, 0.0], [0.1, 1.1, 0.05]],
+        velocities: vec![[0.0, -0.1, 0.0]; 4],
+    };
+    let mut w = NpzWriter::new();
+    mannequin_io::run_record::write_run(&mut w, &run);
+    add_state(&mut w, &state);
+    w.add("frames", frames_array(&[state.positions.clone(), state.positions.clone()], 4));
+    let cloth = w.to_bytes();
+    let training = training_checkpoint();
+    let seeds = [
+        (PathBuf::from("cloth checkpoint"), cloth),
+        (PathBuf::from("training checkpoint"), training.1.clone()),
+    ];
+    mutations_of("checkpoint", &seeds, allowance, |b| {
+        let npz = npz(b)?;
+        if npz.contains("iteration") {
+            return via_file("checkpoint.npz", b, |p| {
+                mannequin_avatar::Checkpoint::open(p, &training.0, &[]).map(drop).map_err(|e| e.to_string())
+            });
+        }
+        check_run(&npz, &run).map_err(|e| e.to_string())?;
+        read_state(&npz, 4).map_err(|e| e.to_string())?;
+        read_frames(&npz, "frames", 4).map(drop).map_err(|e| e.to_string())
+    });
+}
+
+/// A training run's record and a checkpoint of it at iteration 3 (counters only: the arrays are
+/// read as the trainer resumes, through the same `Npz` readers the other cases mutate).
+fn training_checkpoint() -> (mannequin_avatar::TrainingRun, Vec<u8>) {
+    use mannequin_avatar::{AvatarConfig, Method, SkirtMode, TrainOptions, TrainingRun};
+    let hash = "0123456789abcdef".to_string();
+    let run = TrainingRun {
+        body: "default".into(),
+        downscale: 1,
+        skirt: SkirtMode::Auto,
+        garments: None,
+        data: mannequin_io::fingerprint::Fingerprint {
+            files: 3,
+            bytes: 1000,
+            listing: hash.clone(),
+            cameras: hash.clone(),
+            poses: hash,
+        },
+        avatar: AvatarConfig::new(Method::Tavatar, 0),
+        options: TrainOptions::new(Method::Tavatar, 10, 0),
+    };
+    let mut w = NpzWriter::new();
+    run.write(&mut w);
+    w.add("iteration", NpyArray::i64(vec![1], vec![3]));
+    w.add("adam_step", NpyArray::i64(vec![1], vec![3]));
+    (run, w.to_bytes())
+}
+
