@@ -170,10 +170,11 @@ impl Crate {
     ) -> Option<Module> {
         let cut = (0..=path.len()).rev().find(|&i| self.modules.contains_key(&path[..i]))?;
         let module = path[..cut].to_vec();
-        if let Some(target) = path.get(cut).and_then(|name| exports[&module].get(name)) {
-            if hops < 8 && target != path {
-                return self.owner(target, exports, hops + 1);
-            }
+        if let Some(target) = path.get(cut).and_then(|name| exports[&module].get(name))
+            && hops < 8
+            && target != path
+        {
+            return self.owner(target, exports, hops + 1);
         }
         Some(module)
     }
