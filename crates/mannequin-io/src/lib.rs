@@ -1,6 +1,7 @@
-//! File plumbing shared by every Mannequin crate: NumPy arrays (in `.npy`, `.npz`, or pickled),
-//! PLY headers and values, atomic writes, the limits on what any reader accepts, checkpoint run
-//! records and progress bars.
+//! What every Mannequin crate shares, at the bottom of the house: NumPy arrays (in `.npy`, `.npz`,
+//! or pickled), PLY headers and values, atomic writes and staged outputs, the limits on what any
+//! reader accepts, checkpoint run records, progress bars, the seeded RNG, content fingerprints
+//! and video encoding through `ffmpeg`.
 
 pub mod atomic;
 pub mod error;
