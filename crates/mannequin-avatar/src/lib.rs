@@ -14,6 +14,7 @@ pub mod config;
 pub mod error;
 pub mod evaluation;
 pub mod export;
+pub mod export_files;
 pub mod field;
 pub mod fused_binding;
 pub mod fused_mlp;

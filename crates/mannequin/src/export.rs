@@ -4,14 +4,14 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use burn::tensor::Device;
-use mannequin_avatar::params::host_rows;
-use mannequin_avatar::{Avatar, Posed, export};
+use mannequin_avatar::Avatar;
+use mannequin_avatar::export;
+use mannequin_avatar::export_files::{ExportFile, MeshExport, mesh_files};
 use mannequin_body::Motion;
 use mannequin_io::progress::JobTimer;
-use mannequin_mesh::gltf::scene_glb_bytes;
-use mannequin_mesh::{TriMesh, write_mesh};
+use mannequin_mesh::write_mesh;
 
 use crate::shared::PoseChoice;
 
@@ -53,50 +53,6 @@ fn is_glb(path: &Path) -> Result<bool> {
     }
 }
 
-/// One file of an export, made whole in memory and checked before any file is written, so an
-/// export that fails writes none.
-enum Made {
-    /// An `.obj` or `.ply` mesh, already validated.
-    Mesh(TriMesh),
-    Bytes(Vec<u8>),
-}
-
-/// The mesh files: a skinned `.glb` at the bind pose, or `.obj`/`.ply` at the pose (V_s exactly
-/// when `canonical`) with a file per garment layer beside it; each with vertex colour baked from
-/// the Gaussians.
-fn mesh_files(
-    avatar: &Avatar,
-    posed: &Posed,
-    canonical: bool,
-    glb: Option<Option<&Motion>>,
-    output: &Path,
-) -> Result<Vec<(PathBuf, Made)>> {
-    if let Some(motion) = glb {
-        let (body, layers) = export::skinned_layers(avatar, posed)?;
-        let animation = motion.map(|m| avatar.animation(m)).transpose()?;
-        let bytes = scene_glb_bytes(output, &body, &layers, animation.as_ref(), &[])?;
-        return Ok(vec![(output.to_path_buf(), Made::Bytes(bytes))]);
-    }
-    let vertices = if canonical { &posed.personalised } else { &posed.vertices };
-    let mut mesh = TriMesh::new(host_rows(vertices.clone()), avatar.canonical.faces.clone());
-    mesh.colors = Some(export::vertex_colours(avatar, posed)?);
-    // A layer is part of the mesh: valid if the whole is.
-    mesh.validate().map_err(|e| anyhow!("{}: {e}", output.display()))?;
-    let layers = avatar.canonical.garment_names().iter().map(|name| {
-        let part = avatar.canonical.layer_mesh(name, &mesh).expect("a layer the canonical mesh names");
-        (layer_path(output, name), Made::Mesh(part))
-    });
-    let layers: Vec<_> = layers.collect();
-    Ok([(output.to_path_buf(), Made::Mesh(mesh))].into_iter().chain(layers).collect())
-}
-
-/// Where a layer of `output` goes: `<stem>.<layer>.<extension>` beside it.
-fn layer_path(output: &Path, layer: &str) -> PathBuf {
-    let stem = output.file_stem().map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
-    let extension = output.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
-    output.with_file_name(format!("{stem}.{layer}{extension}"))
-}
-
 pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("export");
     // Every argument is checked before the model loads.
@@ -123,22 +79,27 @@ pub fn run(args: Args) -> Result<()> {
     let posed = avatar.pose(&pose, transl)?;
     let mut files = Vec::new();
     if let (Some(output), Some(glb)) = (&args.output, glb) {
-        files = mesh_files(&avatar, &posed, args.pose.is_rest(), glb.then_some(motion.as_ref()), output)?;
+        let how = if glb {
+            MeshExport::Glb { motion: motion.as_ref() }
+        } else {
+            MeshExport::Posed { canonical: args.pose.is_rest() }
+        };
+        files = mesh_files(&avatar, &posed, how, output)?;
     }
     let writing = |path: &Path| format!("writing {}", path.display());
     if let Some(path) = &args.gaussians {
         let scene = export::gaussian_scene(&avatar, &posed.gaussians)?;
-        files.push((path.clone(), Made::Bytes(scene.ply_bytes(&[]).with_context(|| writing(path))?)));
+        files.push((path.clone(), ExportFile::Bytes(scene.ply_bytes(&[]).with_context(|| writing(path))?)));
     }
     if let Some(path) = &args.skinned_gaussians {
         let bytes = export::skinned_gaussians_ply(&avatar, &avatar.canonical_pose()?)
             .with_context(|| writing(path))?;
-        files.push((path.clone(), Made::Bytes(bytes)));
+        files.push((path.clone(), ExportFile::Bytes(bytes)));
     }
     for (path, made) in files {
         match made {
-            Made::Mesh(mesh) => write_mesh(&path, &mesh)?,
-            Made::Bytes(bytes) => {
+            ExportFile::Mesh(mesh) => write_mesh(&path, &mesh)?,
+            ExportFile::Bytes(bytes) => {
                 mannequin_io::write_atomic(&path, &bytes).with_context(|| writing(&path))?
             }
         }
