@@ -61,15 +61,6 @@ pub struct TrainSettings {
     /// mid-thigh) or off.
     #[arg(long, value_enum, default_value_t = TrainSettings::default().skirt)]
     pub skirt: SkirtMode,
-    /// Garments worn as layers of their own, each reconstructed from the label maps (as
-    /// `garment fit` does) before the avatar trains over it: `auto` (every garment in the label
-    /// maps' legend) or categories, e.g. `upper:tshirt,lower:pants`. A skirt or dress replaces
-    /// the skirt layer. Fits are written to OUT/garments/<category>/.
-    #[arg(long)]
-    pub garments: Option<String>,
-    /// Steps of each garment's reconstruction (`garment fit --iters`).
-    #[arg(long, default_value_t = TrainSettings::default().garment_iters, requires = "garments")]
-    pub garment_iters: usize,
     /// Where training runs: cpu (Flex) or gpu (wgpu on Vulkan).
     #[arg(long, value_enum, default_value_t = TrainSettings::default().device)]
     pub device: Compute,
@@ -94,8 +85,6 @@ impl Default for TrainSettings {
             antialiased: false,
             dilation: AVATAR_DILATION,
             skirt: SkirtMode::Auto,
-            garments: None,
-            garment_iters: 400,
             device: Compute::Cpu,
             restart: false,
         }
@@ -160,12 +149,11 @@ mod tests {
         assert_eq!(s.options().lambda_equilateral, 0.0);
         assert!(parse(&["--subdivide", "4"]).is_err());
         assert!(parse(&["--dilation", "-1"]).is_err());
-        assert!(parse(&["--garment-iters", "5"]).is_err(), "--garment-iters without --garments");
     }
 
     #[test]
     fn settings_read_back_from_json_with_missing_ones_at_their_defaults() {
-        let s = TrainSettings { iterations: 7, garments: Some("auto".into()), ..TrainSettings::default() };
+        let s = TrainSettings { iterations: 7, skirt: SkirtMode::Off, ..TrainSettings::default() };
         let text = serde_json::to_string(&s).unwrap();
         assert_eq!(serde_json::from_str::<TrainSettings>(&text).unwrap(), s);
         let seeded = serde_json::from_str::<TrainSettings>(r#"{"seed": 3, "device": "cpu"}"#).unwrap();

@@ -40,6 +40,8 @@ pub struct WornGarments {
     pub names: Vec<String>,
     /// Whether one of them (a skirt or dress) replaces the skirt layer.
     pub replace_skirt: bool,
+    /// Steps of each one's reconstruction.
+    pub steps: usize,
 }
 
 /// A subject with its run's record checked against the model folder, and its views loaded.
@@ -82,7 +84,7 @@ impl Subject {
             downscale: s.downscale,
             skirt,
             garments: (!garments.names.is_empty())
-                .then_some(GarmentRecord { categories: garments.names, steps: s.garment_iters }),
+                .then_some(GarmentRecord { categories: garments.names, steps: garments.steps }),
             data: self.dataset.fingerprint(&self.split)?,
             avatar: s.avatar_config(),
             options: s.options(),
