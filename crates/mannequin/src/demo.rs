@@ -8,6 +8,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args as ClapArgs;
+use mannequin_avatar::TrainSettings;
+use mannequin_synth::SynthOptions;
 
 use mannequin_io::progress::{JobTimer, set_stage};
 
@@ -20,10 +22,10 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Training iterations.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = TrainSettings::default().iterations)]
     iters: usize,
     /// Image size of the synthetic subject.
-    #[arg(long, default_value_t = 540)]
+    #[arg(long, default_value_t = SynthOptions::default().size)]
     size: usize,
     /// Frames of the walk animation.
     #[arg(long, default_value_t = 60)]

@@ -10,7 +10,7 @@ use mannequin_io::progress::{JobTimer, bar};
 #[derive(clap::Args)]
 pub struct Args {
     /// Seed of every random choice (shape, outfit, prints, motion).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = SynthOptions::default().seed)]
     seed: u64,
     /// Output folder (created); the capture goes at its root, test sets under test/.
     #[arg(long)]
@@ -19,16 +19,16 @@ pub struct Args {
     #[arg(long, default_value = "default")]
     body: String,
     /// Image width and height in pixels.
-    #[arg(long, default_value_t = 540)]
+    #[arg(long, default_value_t = SynthOptions::default().size)]
     size: usize,
     /// Render at this multiple of the size and box-filter down (anti-aliasing).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = SynthOptions::default().supersample)]
     supersample: usize,
     /// Frames of the turning capture.
-    #[arg(long, default_value_t = 120)]
+    #[arg(long, default_value_t = SynthOptions::default().capture_frames)]
     frames: usize,
     /// Of those, the first N form the training split; the rest are the test split.
-    #[arg(long, default_value_t = 96)]
+    #[arg(long, default_value_t = SynthOptions::default().train_frames)]
     train: usize,
 }
 
