@@ -18,7 +18,7 @@ use mannequin_data::metrics::{
 };
 use mannequin_io::rng::SplitMix64;
 use mannequin_io::{NpyArray, NpzWriter};
-use mannequin_mesh::TriMesh;
+use mannequin_mesh::{TriMesh, uv_ellipsoid};
 
 const SIZE: usize = 540;
 
@@ -42,26 +42,6 @@ fn time<T>(n: usize, mut f: impl FnMut() -> T) -> f64 {
         std::hint::black_box(f());
     }
     t.elapsed().as_secs_f64() / n as f64
-}
-
-fn sphere(rings: usize, segments: usize) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-    let mut pos = Vec::new();
-    for i in 0..=rings {
-        let th = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..segments {
-            let ph = std::f32::consts::TAU * j as f32 / segments as f32;
-            pos.push([0.3 * th.sin() * ph.cos(), 0.9 * th.cos(), 0.2 * th.sin() * ph.sin()]);
-        }
-    }
-    let idx = |i: usize, j: usize| (i * segments + j % segments) as u32;
-    let faces = (0..rings)
-        .flat_map(|i| {
-            (0..segments).flat_map(move |j| {
-                [[idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)], [idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]]
-            })
-        })
-        .collect();
-    (pos, faces)
 }
 
 /// LPIPS with random weights (uniform in ±sqrt(6 / fan-in)), through a weights file.
@@ -114,7 +94,7 @@ fn main() {
         l1 / ln
     );
 
-    let (pos, faces) = sphere(90, 144);
+    let (pos, faces) = uv_ellipsoid([0.0; 3], [0.3, 0.9, 0.2], 90, 144);
     let gt = TriMesh::new(pos.clone(), faces.clone());
     let pred = TriMesh::new(pos.iter().map(|p| [p[0] * 1.01, p[1], p[2] + 0.003]).collect(), faces.clone());
     let g1 = single.install(|| time(1, || geometry_metrics(&pred, &gt, 100_000, 0)));

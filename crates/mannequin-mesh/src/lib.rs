@@ -23,6 +23,7 @@ pub mod remesh;
 pub mod ring_tube;
 pub mod subdivide;
 pub mod tri_mesh;
+pub mod uv_ellipsoid;
 
 pub use area::double_areas;
 pub use closest_point::{ClosestPoint, SurfacePoint};
@@ -38,3 +39,4 @@ pub use mesh_file::{MeshWriteError, write_mesh};
 pub use obj::{Obj, ObjGroup, read_obj, write_obj};
 pub use pc2::PointCache;
 pub use tri_mesh::{MeshError, TriMesh, UvLayout, points};
+pub use uv_ellipsoid::uv_ellipsoid;

@@ -5,6 +5,7 @@
 use std::time::Instant;
 
 use mannequin_data::Camera;
+use mannequin_mesh::uv_ellipsoid;
 use mannequin_raster::{RasterMesh, Shading, rasterize};
 
 const SIZE: usize = 540;
@@ -19,32 +20,11 @@ fn time<T>(n: usize, mut f: impl FnMut() -> T) -> f64 {
     t.elapsed().as_secs_f64() / n as f64
 }
 
-/// An ellipsoid of `rings` × `segments` quads, each split in two triangles.
-fn sphere(rings: usize, segments: usize) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-    let mut pos = Vec::new();
-    for i in 0..=rings {
-        let th = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..segments {
-            let ph = std::f32::consts::TAU * j as f32 / segments as f32;
-            pos.push([0.3 * th.sin() * ph.cos(), 0.9 * th.cos(), 0.2 * th.sin() * ph.sin()]);
-        }
-    }
-    let idx = |i: usize, j: usize| (i * segments + j % segments) as u32;
-    let faces = (0..rings)
-        .flat_map(|i| {
-            (0..segments).flat_map(move |j| {
-                [[idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)], [idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]]
-            })
-        })
-        .collect();
-    (pos, faces)
-}
-
 fn main() {
     let threads = rayon::current_num_threads();
     let single = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("thread pool");
     println!("mannequin-raster benchmarks at {SIZE}×{SIZE}, {threads} threads");
-    let (pos, faces) = sphere(90, 144);
+    let (pos, faces) = uv_ellipsoid([0.0; 3], [0.3, 0.9, 0.2], 90, 144);
     let normals = mannequin_mesh::normals::vertex_normals(&pos, &faces);
     let mesh =
         RasterMesh { positions: &pos, faces: &faces, normals: &normals, shading: Shading::Flat([0.8; 3]) };

@@ -119,26 +119,9 @@ struct Sphere {
 }
 
 fn uv_sphere(centre: [f32; 3], r: f32, rings: usize, segments: usize) -> Sphere {
-    let mut pos = Vec::new();
-    let mut nrm = Vec::new();
-    for i in 0..=rings {
-        let th = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..segments {
-            let ph = std::f32::consts::TAU * j as f32 / segments as f32;
-            let n = [th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()];
-            nrm.push(n);
-            pos.push([centre[0] + r * n[0], centre[1] + r * n[1], centre[2] + r * n[2]]);
-        }
-    }
-    let idx = |i: usize, j: usize| (i * segments + j % segments) as u32;
-    let mut faces = Vec::new();
-    for i in 0..rings {
-        for j in 0..segments {
-            faces.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-            faces.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-        }
-    }
-    Sphere { positions: pos, faces, normals: nrm }
+    let (positions, faces) = mannequin_mesh::uv_ellipsoid(centre, [r; 3], rings, segments);
+    let normals = positions.iter().map(|p| std::array::from_fn(|k| (p[k] - centre[k]) / r)).collect();
+    Sphere { positions, faces, normals }
 }
 
 #[test]
