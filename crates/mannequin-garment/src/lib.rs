@@ -23,9 +23,9 @@ mod transfer;
 mod wear;
 
 pub use category::{CATEGORY_NAMES, Category};
-pub use ease::{Ease, SIZE_NAMES};
 pub use dress_error::DressError;
 pub use dressing::{DressJob, DressSettings, Dressing, Wardrobe, dress};
+pub use ease::{Ease, SIZE_NAMES};
 pub use error::GarmentError;
 pub use garment::{Garment, Recipe};
 pub use garment_cache::load_or_make;

@@ -9,17 +9,17 @@ use mannequin_garment::{Dressed, GarmentError, WearProgress, Wearer, wear};
 use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::{TriMesh, UvLayout, points};
 
+use crate::error::SynthError;
 use crate::subject::Subject;
 use crate::texture::{BakeInput, SurfacePoint, bake, smoothstep};
 use crate::wardrobe::{Piece, Worn, dress_subject, triangle_atlas};
 use mannequin_body::smpl_joint as joint;
 use mannequin_data::Camera;
-use crate::error::SynthError;
 use mannequin_data::image::{Image, Mask};
 use mannequin_data::labels::LabelMap;
 use mannequin_data::maps::{DepthMap, NormalMap};
-use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 use mannequin_io::rng::SplitMix64;
+use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 
 /// Texture size of the body's UV atlas and of each garment's triangle atlas beside it (square,
 /// all one size, so the atlas's rows line up).

@@ -1,9 +1,9 @@
 //! The subject's clothes: garments of the library (`mannequin-garment`), made on the subject's
 //! own body at the outfit's sizes and layered inner first, each with a texture of its print.
 
+use crate::error::SynthError;
 use glam::{Vec2, Vec3};
 use mannequin_body::BodyModel;
-use crate::error::SynthError;
 use mannequin_garment::{Category, Ease, Garment, make_garment};
 use mannequin_mesh::{TriMesh, UvLayout};
 

@@ -444,4 +444,3 @@ fn training_checkpoint() -> (mannequin_avatar::TrainingRun, Vec<u8>) {
     w.add("adam_step", NpyArray::i64(vec![1], vec![3]));
     (run, w.to_bytes())
 }
-
