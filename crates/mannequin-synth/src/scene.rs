@@ -26,8 +26,6 @@ use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 const TEXTURE: usize = 2048;
 /// Share of each garment triangle's atlas cell left round it for the baker's dilation.
 const ATLAS_MARGIN: f32 = 0.12;
-/// Seconds the garments settle on the body before each sequence's first frame.
-const SETTLE_SECONDS: f32 = 1.0;
 
 /// Where a camera looks from, relative to the subject's bounding box centre: azimuth about +Y
 /// (0 is in front, on +Z), elevation, distance as a multiple of 3.3 m, and roll.
@@ -305,7 +303,7 @@ impl Scene {
             fps,
             gender: None,
         };
-        let schedule = Settling::new(model, &motion, SETTLE_SECONDS)?;
+        let schedule = Settling::new(model, &motion, mannequin_cloth::SETTLE_SECONDS)?;
         let body_frames = schedule.body_frames(model, &self.shaped)?;
         let fail = |e: GarmentError| SynthError::Invalid(format!("dressing the subject: {e}"));
         let dressed: Vec<Dressed> = self

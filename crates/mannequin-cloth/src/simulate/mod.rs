@@ -9,6 +9,7 @@ mod pins;
 mod placement;
 mod progress;
 mod settings;
+mod stepping;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -29,7 +30,8 @@ use metrics::FrameMetrics;
 use pins::{Pins, read_pins};
 use placement::check_placement;
 use progress::{ClothRun, Progress, read_checkpoint, write_checkpoint};
-pub use settings::{SETTLE_SECONDS, SimulateSettings};
+pub use settings::SimulateSettings;
+pub use stepping::{SETTLE_SECONDS, Stepping};
 
 /// What a run simulates: the garment (`.obj`, metres, modelled around the body at rest) and its
 /// pins file, on `model` (called `body`, of shape `betas`) playing `motion` (read from
@@ -72,7 +74,7 @@ pub fn simulate(
         .map_err(|e| SimulateError::from(e).of(garment_path.display().to_string()))?;
     let (model, motion) = (job.model, job.motion);
     check_kept_positions(job.motion_path, motion.num_frames(), garment.vertex_count())?;
-    let schedule = Settling::new(model, motion, settings.settle)?;
+    let schedule = Settling::new(model, motion, settings.stepping.settle)?;
     let shaped = shape_body(model, job.betas)?;
     let faces = model.template_mesh().faces;
     let body_at = |k: usize| -> Result<Vec<[f32; 3]>, SimulateError> {
@@ -99,12 +101,15 @@ pub fn simulate(
         fps: motion.fps,
         frames: motion.num_frames(),
         material: settings.material,
-        substeps: settings.substeps,
-        settle: settings.settle,
+        substeps: settings.stepping.substeps,
+        settle: settings.stepping.settle,
         self_collision: settings.self_collision,
     };
-    let solver =
-        Settings { substeps: settings.substeps, self_collision: run.self_collision, ..Settings::default() };
+    let solver = Settings {
+        substeps: settings.stepping.substeps,
+        self_collision: run.self_collision,
+        ..Settings::default()
+    };
     let mut sim = Simulator::new(cloth, Some(Body::new(faces.clone())), attachments, solver)?;
     let checkpoint = out.join(CHECKPOINT);
     if settings.restart {

@@ -1,36 +1,19 @@
-//! `cloth simulate`'s settings: the material, the solver's substeps, the settling time and the
+//! `cloth simulate`'s settings: the material, how the solver steps ([`Stepping`]) and the
 //! self-contacts (what changes the result), and how often a checkpoint is saved. Each default is
 //! written here once; the command line reads it from [`SimulateSettings::default`].
 
 use serde::{Deserialize, Serialize};
 
+use super::stepping::Stepping;
 use crate::material::Material;
-use crate::settings::SUBSTEPS;
-use crate::sim_limits::{MAX_SUBSTEPS, parse_settle};
-
-/// Seconds before the motion by default: half at rest, half blending into its first frame.
-pub const SETTLE_SECONDS: f32 = 1.0;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, clap::Args)]
 pub struct SimulateSettings {
     #[arg(long = "material", value_enum, default_value_t = SimulateSettings::default().material)]
     pub material: Material,
-    /// Simulation substeps per output frame (one constraint iteration each), at most 100.
-    #[arg(
-        long = "substeps",
-        default_value_t = SimulateSettings::default().substeps,
-        allow_hyphen_values = true,
-        value_parser = clap::value_parser!(u32).range(1..=MAX_SUBSTEPS as i64)
-    )]
-    pub substeps: u32,
-    /// Seconds before the motion: half at rest, half blending into its first frame (at most 10).
-    #[arg(
-        long = "settle",
-        default_value_t = SimulateSettings::default().settle,
-        allow_hyphen_values = true,
-        value_parser = parse_settle
-    )]
-    pub settle: f32,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub stepping: Stepping,
     /// Cloth–cloth contacts (vertex–triangle, Eq. 3.22). Experimental: cloth piling onto itself
     /// still tangles in places and they cost about 4× the time, so they are off unless asked
     /// for; metrics.json counts the self-intersecting pairs either way.
@@ -48,8 +31,7 @@ impl Default for SimulateSettings {
     fn default() -> Self {
         Self {
             material: Material::default(),
-            substeps: SUBSTEPS,
-            settle: SETTLE_SECONDS,
+            stepping: Stepping::default(),
             self_collision: false,
             checkpoint_every: 30,
             restart: false,

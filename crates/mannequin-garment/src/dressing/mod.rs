@@ -64,7 +64,7 @@ impl Wardrobe {
             .iter()
             .map(|g| load_or_make(g, model, job.body, &settings.size))
             .collect::<Result<_, _>>()?;
-        let settle = Settling::settle_frames(settings.settle, motion.fps)?;
+        let settle = Settling::settle_frames(settings.stepping.settle, motion.fps)?;
         let vertices = model.num_vertices() + loaded.iter().map(|(_, g)| g.vertex_count()).sum::<usize>();
         check_kept_positions(job.motion_path, settle + motion.num_frames(), vertices)?;
         // Each layer stands clear of those under it (in rest space, so on every body shape).
@@ -125,7 +125,7 @@ pub fn dress<'a>(
     stage_s.insert("transfer".into(), wardrobe.started.elapsed().as_secs_f64().into());
 
     let start = Instant::now();
-    let schedule = Settling::new(model, motion, settings.settle)?;
+    let schedule = Settling::new(model, motion, settings.stepping.settle)?;
     let shaped = shape_body(model, job.betas)?;
     let body_frames = schedule.body_frames(model, &shaped)?;
     let body_faces = model.template_mesh().faces;
@@ -181,7 +181,7 @@ impl<'a> Dressing<'a> {
             fps: job.motion.fps,
         };
         let solver = Settings {
-            substeps: settings.substeps,
+            substeps: settings.stepping.substeps,
             self_collision: settings.self_collision,
             ..Settings::default()
         };
@@ -192,8 +192,8 @@ impl<'a> Dressing<'a> {
             motion: file_hash(job.motion_path)?,
             fps: job.motion.fps,
             frames: job.motion.num_frames(),
-            substeps: settings.substeps,
-            settle: settings.settle,
+            substeps: settings.stepping.substeps,
+            settle: settings.stepping.settle,
             self_collision: settings.self_collision,
         };
         let resume = if checkpoint.exists() {

@@ -1,10 +1,9 @@
-//! `dress`'s settings: the size garments given by category are made at, the solver's substeps,
-//! the settling time, whether the cloth is simulated at all and with self-contacts (what changes
+//! `dress`'s settings: the size garments given by category are made at, how the solver steps
+//! ([`Stepping`]), whether the cloth is simulated at all and with self-contacts (what changes
 //! the result), and how often a checkpoint is saved. Each default is written here once; the
 //! command line reads it from [`DressSettings::default`].
 
-use mannequin_cloth::sim_limits::{MAX_SUBSTEPS, parse_settle};
-use mannequin_cloth::{SETTLE_SECONDS, SUBSTEPS};
+use mannequin_cloth::Stepping;
 use serde::{Deserialize, Serialize};
 
 use crate::ease::SIZE_NAMES;
@@ -18,22 +17,9 @@ pub struct DressSettings {
         value_parser = clap::builder::PossibleValuesParser::new(SIZE_NAMES)
     )]
     pub size: String,
-    /// Simulation substeps per frame, at most 100.
-    #[arg(
-        long = "substeps",
-        default_value_t = DressSettings::default().substeps,
-        allow_hyphen_values = true,
-        value_parser = clap::value_parser!(u32).range(1..=MAX_SUBSTEPS as i64)
-    )]
-    pub substeps: u32,
-    /// Seconds before the motion: half at rest, half blending into its first frame (at most 10).
-    #[arg(
-        long = "settle",
-        default_value_t = DressSettings::default().settle,
-        allow_hyphen_values = true,
-        value_parser = parse_settle
-    )]
-    pub settle: f32,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub stepping: Stepping,
     /// Skin the garments only (Eqs. 3.2–3.3), without the cloth simulator.
     #[arg(long = "no-simulation")]
     pub no_simulation: bool,
@@ -54,8 +40,7 @@ impl Default for DressSettings {
     fn default() -> Self {
         Self {
             size: "M".into(),
-            substeps: SUBSTEPS,
-            settle: SETTLE_SECONDS,
+            stepping: Stepping::default(),
             no_simulation: false,
             self_collision: false,
             checkpoint_every: 60,
