@@ -1,5 +1,6 @@
 //! Errors that say which file, field or iteration went wrong, so a user can act on them.
 
+use mannequin_io::run_record::START_OVER;
 use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
@@ -23,7 +24,7 @@ pub enum AvatarError {
     #[error("the loss became {value} at iteration {iteration}; the last good checkpoint is {checkpoint}")]
     NonFiniteLoss { iteration: usize, value: f64, checkpoint: String },
     /// A checkpoint that cannot be resumed, with the way out.
-    #[error("{0}; use --restart to start over, or another --out")]
+    #[error("{0}; {START_OVER}")]
     CannotResume(Box<AvatarError>),
 }
 

@@ -36,7 +36,9 @@ pub use garment_check::{MAX_GARMENT_FACES, MAX_GARMENT_VERTICES, check_garment};
 pub use material::{MATERIAL_NAMES, Material};
 pub use phase_times::PhaseTimes;
 pub use settings::{SUBSTEPS, SUBSTEPS_TUNED_FPS, Settings};
-pub use simulate::{SETTLE_SECONDS, SimulateJob, SimulateSettings, Simulation, Stepping, simulate};
+pub use simulate::{
+    Performer, SETTLE_SECONDS, SimulateJob, SimulateSettings, Simulation, Stepping, simulate,
+};
 pub use simulate_error::SimulateError;
 pub use simulator::Simulator;
 pub use state::{ClothState, MAX_COORDINATE, MAX_SPEED, check_positions};

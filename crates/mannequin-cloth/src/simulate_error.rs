@@ -6,6 +6,7 @@ use mannequin_io::IoError;
 use mannequin_mesh::MeshFileError;
 
 use crate::error::ClothError;
+use mannequin_io::run_record::START_OVER;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
@@ -19,7 +20,7 @@ pub enum SimulateError {
     #[error("{context}: {inner}")]
     In { context: String, inner: Box<SimulateError> },
     /// A checkpoint of another run, or one that is not what this run saves.
-    #[error("{0}; use --restart to start over, or another --out")]
+    #[error("{0}; {START_OVER}")]
     Refused(IoError),
     /// The run stopped at `error`; the frames before it were written.
     #[error("{error}; kept the {frames} frames before it in {out}")]

@@ -1,5 +1,6 @@
 //! Fitting errors: one line each, naming the input or the model at fault.
 
+use mannequin_io::run_record::START_OVER;
 use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
@@ -19,7 +20,7 @@ pub enum FitError {
     #[error("{doing} {}: {cause}", path.display())]
     File { doing: &'static str, path: PathBuf, cause: std::io::Error },
     /// A checkpoint that cannot resume this run.
-    #[error("{0}; use --restart to start over, or another --out")]
+    #[error("{0}; {START_OVER}")]
     Checkpoint(mannequin_io::IoError),
     #[error(transparent)]
     Body(#[from] mannequin_body::BodyError),

@@ -10,6 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use mannequin_body::{BodyModel, Motion};
+use mannequin_cloth::Performer;
 use mannequin_garment::{DressJob, DressSettings, Wardrobe, dress};
 
 /// The target for the whole job, seconds.
@@ -58,11 +59,13 @@ fn main() {
     let garments = ["pants".to_string(), "tshirt".to_string()];
     let job = DressJob {
         garments: &garments,
-        model: &model,
-        body: "default",
-        betas: &[],
-        motion: &motion,
-        motion_path: &walk_path,
+        performer: Performer {
+            model: &model,
+            body: "default",
+            betas: &[],
+            motion: &motion,
+            motion_path: &walk_path,
+        },
     };
     let skinning = DressSettings { no_simulation: true, ..DressSettings::default() };
     // Make (and cache) the templates first, so both runs below time dressing only.

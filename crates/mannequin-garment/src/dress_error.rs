@@ -1,5 +1,6 @@
 //! Dressing errors: what goes wrong loading garments, simulating them on a body, checkpointing
-//! and writing the scene, one line each with the file or field at fault.
+//! and writing the scene, one line each with the file or field at fault. A bad setting, a file
+//! that cannot be read or written, is the simulating run's own error ([`SimulateError`]).
 
 use mannequin_body::BodyError;
 use mannequin_cloth::{ClothError, SimulateError};
@@ -10,12 +11,6 @@ use crate::error::GarmentError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum DressError {
-    #[error("{field}: {reason}")]
-    Invalid { field: String, reason: String },
-    #[error("reading {path}: {reason}")]
-    Read { path: String, reason: String },
-    #[error("writing {path}: {reason}")]
-    Write { path: String, reason: String },
     /// `inner` said of `context` (a file, a garment): one line, as `anyhow`'s context reads.
     #[error("{context}: {inner}")]
     In { context: String, inner: Box<DressError> },
@@ -34,10 +29,6 @@ pub enum DressError {
 }
 
 impl DressError {
-    pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
-        Self::Invalid { field: field.into(), reason: reason.into() }
-    }
-
     /// This error said of `context`.
     pub(crate) fn of(self, context: impl Into<String>) -> Self {
         Self::In { context: context.into(), inner: Box::new(self) }

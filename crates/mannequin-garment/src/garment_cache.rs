@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mannequin_body::BodyModel;
+use mannequin_cloth::SimulateError;
+use mannequin_cloth::run_checkpoint::file_hash;
 
 use crate::category::{CATEGORY_NAMES, Category};
 use crate::dress_error::DressError;
@@ -29,23 +31,18 @@ pub fn load_or_make(
     let Ok(category) = Category::named(spec) else {
         let path = Path::new(spec);
         if !path.exists() {
-            return Err(DressError::invalid(
+            return Err(SimulateError::invalid(
                 "--garments",
                 format!("{spec:?} is neither a .garment file nor a category ({})", CATEGORY_NAMES.join(", ")),
-            ));
+            )
+            .into());
         }
         let garment = read_garment(path)?;
         garment.check_body(model).map_err(|e| DressError::from(e).of(path.display().to_string()))?;
         let name = path.file_stem().map_or_else(|| "garment".into(), |s| s.to_string_lossy().into_owned());
         return Ok((name, garment));
     };
-    let body_key = if Path::new(body).exists() {
-        let bytes = std::fs::read(body)
-            .map_err(|e| DressError::Read { path: body.to_string(), reason: e.to_string() })?;
-        mannequin_io::fingerprint::hash_bytes(&bytes)
-    } else {
-        body.to_string()
-    };
+    let body_key = if Path::new(body).exists() { file_hash(Path::new(body))? } else { body.to_string() };
     let key =
         format!("{}-{size}-{body_key}-v{}-r{TEMPLATE_REVISION}", category.name(), env!("CARGO_PKG_VERSION"));
     let cache = cache_dir().map(|d| d.join("garments").join(format!("{key}.garment")));

@@ -13,6 +13,9 @@ use crate::{IoError, NpyArray, Npz, NpzWriter};
 /// The checkpoint member that holds the record.
 pub const RUN_MEMBER: &str = "run";
 
+/// The way out a refused checkpoint offers, in every command that resumes one.
+pub const START_OVER: &str = "use --restart to start over, or another --out";
+
 /// Stores `run` (everything that changes the result) as the checkpoint's record.
 pub fn write_run<T: Serialize>(w: &mut NpzWriter, run: &T) {
     w.add(RUN_MEMBER, NpyArray::text(&to_json(run)));

@@ -8,13 +8,14 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args as ClapArgs;
 use mannequin_body::load_body;
+use mannequin_cloth::Performer;
 use mannequin_garment::dressing::RegionFit;
 use mannequin_garment::{DressJob, DressSettings, Dressing, Wardrobe, dress};
 use mannequin_io::progress::JobTimer;
+use mannequin_io::staging::Staging;
 use mannequin_splat::read_camera;
 
 use crate::shared::{BodyArgs, Clip};
-use mannequin_io::staging::Staging;
 
 mod frames;
 
@@ -54,11 +55,13 @@ pub fn run(args: Args) -> Result<()> {
     let camera = args.camera.as_deref().map(read_camera).transpose()?.map(|(camera, _)| camera);
     let job = DressJob {
         garments: &args.garments,
-        model: &model,
-        body: &args.body.body,
-        betas: &args.body.betas,
-        motion: &motion,
-        motion_path: &args.clip.motion,
+        performer: Performer {
+            model: &model,
+            body: &args.body.body,
+            betas: &args.body.betas,
+            motion: &motion,
+            motion_path: &args.clip.motion,
+        },
     };
     let wardrobe = Wardrobe::load(&job, &args.settings)?;
     let mut dressing = dress(&wardrobe, &job, &args.settings, &args.out)?;

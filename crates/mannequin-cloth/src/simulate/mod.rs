@@ -5,6 +5,7 @@
 
 mod metrics;
 mod outputs;
+mod performer;
 mod pins;
 mod placement;
 mod progress;
@@ -14,7 +15,7 @@ mod stepping;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use mannequin_body::{BodyModel, Motion, Settling, pose_frames, shape_body};
+use mannequin_body::{Settling, pose_frames, shape_body};
 use mannequin_mesh::{TriMesh, points, read_obj};
 
 use crate::attachment::Attachment;
@@ -27,6 +28,7 @@ use crate::sim_limits::check_kept_positions;
 use crate::simulate_error::SimulateError;
 use crate::simulator::Simulator;
 use metrics::FrameMetrics;
+pub use performer::Performer;
 use pins::{Pins, read_pins};
 use placement::check_placement;
 use progress::{ClothRun, Progress, read_checkpoint, write_checkpoint};
@@ -34,16 +36,11 @@ pub use settings::SimulateSettings;
 pub use stepping::{SETTLE_SECONDS, Stepping};
 
 /// What a run simulates: the garment (`.obj`, metres, modelled around the body at rest) and its
-/// pins file, on `model` (called `body`, of shape `betas`) playing `motion` (read from
-/// `motion_path`).
+/// pins file, on the body performing the motion.
 pub struct SimulateJob<'a> {
     pub garment: &'a Path,
     pub pins: Option<&'a Path>,
-    pub model: &'a BodyModel,
-    pub body: &'a str,
-    pub betas: &'a [f32],
-    pub motion: &'a Motion,
-    pub motion_path: &'a Path,
+    pub performer: Performer<'a>,
 }
 
 /// A run simulated as far as it went: the motion frames recorded and their metrics, and the
@@ -72,10 +69,10 @@ pub fn simulate(
     };
     let cloth = Cloth::new(&garment, &settings.material, &pins.fixed)
         .map_err(|e| SimulateError::from(e).of(garment_path.display().to_string()))?;
-    let (model, motion) = (job.model, job.motion);
-    check_kept_positions(job.motion_path, motion.num_frames(), garment.vertex_count())?;
+    let (model, motion) = (job.performer.model, job.performer.motion);
+    check_kept_positions(job.performer.motion_path, motion.num_frames(), garment.vertex_count())?;
     let schedule = Settling::new(model, motion, settings.stepping.settle)?;
-    let shaped = shape_body(model, job.betas)?;
+    let shaped = shape_body(model, job.performer.betas)?;
     let faces = model.template_mesh().faces;
     let body_at = |k: usize| -> Result<Vec<[f32; 3]>, SimulateError> {
         let (pose, trans) = schedule.pose(k);
@@ -95,9 +92,9 @@ pub fn simulate(
             Some(p) => file_hash(p)?,
             None => "none".into(),
         },
-        motion: file_hash(job.motion_path)?,
-        body: job.body.to_string(),
-        betas: job.betas.to_vec(),
+        motion: file_hash(job.performer.motion_path)?,
+        body: job.performer.body.to_string(),
+        betas: job.performer.betas.to_vec(),
         fps: motion.fps,
         frames: motion.num_frames(),
         material: settings.material,
@@ -170,7 +167,7 @@ impl Simulation {
     /// garment.pc2, garment.npz, scene.glb and metrics.json for the frames recorded, into `dir`
     /// (a staging folder the caller moves into `out`).
     pub fn write(&self, dir: &Path, out: &Path, job: &SimulateJob) -> Result<(), SimulateError> {
-        let body = (job.model, job.betas, job.motion);
+        let body = (job.performer.model, job.performer.betas, job.performer.motion);
         let frames = &self.progress.frames;
         let summary =
             outputs::write_outputs(dir, &self.garment, body, frames, &self.progress.metrics, &self.phases)?;

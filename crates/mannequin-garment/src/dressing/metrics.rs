@@ -4,7 +4,7 @@
 use std::ops::Range;
 use std::path::Path;
 
-use mannequin_cloth::quality;
+use mannequin_cloth::{SimulateError, quality};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -111,7 +111,7 @@ pub(super) fn write_metrics(
     serde_json::to_string_pretty(&summary)
         .map_err(|e| e.to_string())
         .and_then(write)
-        .map_err(|reason| DressError::Write { path: path.display().to_string(), reason })?;
+        .map_err(|reason| SimulateError::Write { path: path.display().to_string(), reason })?;
     for g in summary["garments"].as_array().into_iter().flatten() {
         tracing::info!(
             "{}: at most {} vertices inside the body, {} crossings with inner layers; strain mean {:.3}, \

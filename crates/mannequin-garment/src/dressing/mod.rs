@@ -14,10 +14,10 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use mannequin_body::{BodyModel, Motion, Settling, shape_body};
-use mannequin_cloth::Settings;
+use mannequin_body::{Settling, shape_body};
 use mannequin_cloth::run_checkpoint::{CHECKPOINT, file_hash};
 use mannequin_cloth::sim_limits::check_kept_positions;
+use mannequin_cloth::{Performer, Settings};
 use mannequin_mesh::MorphSequence;
 
 use crate::dress_error::DressError;
@@ -37,14 +37,10 @@ pub use worn::Worn;
 const LAYER_GAP: f32 = 0.01;
 
 /// What a dressing wears and where: garments (inner first: `.garment` files or category names),
-/// on `model` (called `body`, of shape `betas`) playing `motion` (read from `motion_path`).
+/// on the body performing the motion.
 pub struct DressJob<'a> {
     pub garments: &'a [String],
-    pub model: &'a BodyModel,
-    pub body: &'a str,
-    pub betas: &'a [f32],
-    pub motion: &'a Motion,
-    pub motion_path: &'a Path,
+    pub performer: Performer<'a>,
 }
 
 /// The garments to wear, named, inner first, each standing clear of those under it at rest.
@@ -58,15 +54,15 @@ impl Wardrobe {
     /// positions than [`mannequin_cloth::sim_limits::MAX_KEPT_POSITIONS`], and layers them.
     pub fn load(job: &DressJob, settings: &DressSettings) -> Result<Self, DressError> {
         let started = Instant::now();
-        let (model, motion) = (job.model, job.motion);
+        let (model, motion) = (job.performer.model, job.performer.motion);
         let loaded: Vec<(String, Garment)> = job
             .garments
             .iter()
-            .map(|g| load_or_make(g, model, job.body, &settings.size))
+            .map(|g| load_or_make(g, model, job.performer.body, &settings.size))
             .collect::<Result<_, _>>()?;
         let settle = Settling::settle_frames(settings.stepping.settle, motion.fps)?;
         let vertices = model.num_vertices() + loaded.iter().map(|(_, g)| g.vertex_count()).sum::<usize>();
-        check_kept_positions(job.motion_path, settle + motion.num_frames(), vertices)?;
+        check_kept_positions(job.performer.motion_path, settle + motion.num_frames(), vertices)?;
         // Each layer stands clear of those under it (in rest space, so on every body shape).
         let templates = loaded
             .iter()
@@ -104,13 +100,13 @@ pub fn dress<'a>(
     settings: &DressSettings,
     out: &Path,
 ) -> Result<Dressing<'a>, DressError> {
-    let (model, motion) = (job.model, job.motion);
+    let (model, motion) = (job.performer.model, job.performer.motion);
     let templates = &wardrobe.templates;
     let worn: Vec<Worn> = templates
         .iter()
         .enumerate()
         .map(|(i, (name, garment))| {
-            let dressed = Dressed::new(garment, model, job.betas)
+            let dressed = Dressed::new(garment, model, job.performer.betas)
                 .map_err(|e| DressError::from(e).of(format!("dressing {name}")))?;
             let name = if templates[..i].iter().any(|(n, _)| n == name) {
                 format!("{name}_{i}")
@@ -126,7 +122,7 @@ pub fn dress<'a>(
 
     let start = Instant::now();
     let schedule = Settling::new(model, motion, settings.stepping.settle)?;
-    let shaped = shape_body(model, job.betas)?;
+    let shaped = shape_body(model, job.performer.betas)?;
     let body_frames = schedule.body_frames(model, &shaped)?;
     let body_faces = model.template_mesh().faces;
     stage_s.insert("body".into(), start.elapsed().as_secs_f64().into());
@@ -178,7 +174,7 @@ impl<'a> Dressing<'a> {
             faces: &self.body_faces,
             frames: &self.body_frames,
             schedule: &self.schedule,
-            fps: job.motion.fps,
+            fps: job.performer.motion.fps,
         };
         let solver = Settings {
             substeps: settings.stepping.substeps,
@@ -187,11 +183,11 @@ impl<'a> Dressing<'a> {
         };
         let run = DressRun {
             garments: worn.iter().map(|w| format!("{} {}", w.name, template_hash(w.garment))).collect(),
-            body: job.body.to_string(),
-            betas: job.betas.to_vec(),
-            motion: file_hash(job.motion_path)?,
-            fps: job.motion.fps,
-            frames: job.motion.num_frames(),
+            body: job.performer.body.to_string(),
+            betas: job.performer.betas.to_vec(),
+            motion: file_hash(job.performer.motion_path)?,
+            fps: job.performer.motion.fps,
+            frames: job.performer.motion.num_frames(),
             substeps: settings.stepping.substeps,
             settle: settings.stepping.settle,
             self_collision: settings.self_collision,
@@ -283,7 +279,7 @@ impl<'a> Dressing<'a> {
         metrics: &[Vec<FrameMetrics>],
     ) -> Result<(), DressError> {
         let start = Instant::now();
-        let (model, motion) = (job.model, job.motion);
+        let (model, motion) = (job.performer.model, job.performer.motion);
         let frames = self.motion_frames();
         let morphs: Vec<MorphSequence> = self
             .worn
@@ -301,7 +297,7 @@ impl<'a> Dressing<'a> {
         let poses = motion.poses_for(model)?;
         let pl = model.pose_len();
         let played = (&poses[..f * pl], &motion.trans[..3 * f], motion.fps);
-        write_layered_scene(&dir.join("dressed.glb"), model, job.betas, played, &morphs)?;
+        write_layered_scene(&dir.join("dressed.glb"), model, job.performer.betas, played, &morphs)?;
         self.time("write", start);
         metrics::write_metrics(dir, &self.worn, metrics, motion.fps, &self.stage_s)
     }
