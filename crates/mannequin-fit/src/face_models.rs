@@ -9,7 +9,7 @@ use crate::face_landmarker::{FaceLandmarks, MIN_FACE_FLAG, detection_roi, estima
 use crate::network::Network;
 use crate::ssd_detector::{Detection, FACE};
 
-const FACE_DETECTION: &[u8] = include_bytes!("../models/face_detection_short_range.onnx");
+pub(crate) const FACE_DETECTION: &[u8] = include_bytes!("../models/face_detection_short_range.onnx");
 const FACE_LANDMARK: &[u8] = include_bytes!("../models/face_landmark.onnx");
 
 /// The face mesh reads a 192² crop 1.5× the face box: a box much under 48 pixels is upsampled

@@ -1,14 +1,16 @@
 //! The shipped person models, loaded once: MediaPipe's pose detector, pose landmarker and
-//! selfie segmenter (Apache-2.0, converted to ONNX by `tools/person_models`; see
+//! selfie segmenter, and BlazeFace to find a body from its face (Apache-2.0, converted to ONNX by `tools/person_models`; see
 //! `models/NOTICE.md`).
 
 use mannequin_data::Image;
 
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
+use crate::face_models::FACE_DETECTION;
 use crate::network::Network;
-use crate::pose_landmarker::{MIN_POSE_FLAG, PoseLandmarks, detection_roi, estimate};
-use crate::ssd_detector::{Detection, POSE, letterbox};
+use crate::person_search::{body_seeds, windows};
+use crate::pose_landmarker::{MIN_POSE_FLAG, PoseLandmarks, aligned_roi, detection_roi, estimate};
+use crate::ssd_detector::{Detection, FACE, POSE, letterbox, suppress};
 
 const POSE_DETECTION: &[u8] = include_bytes!("../models/pose_detection.onnx");
 const POSE_LANDMARK: &[u8] = include_bytes!("../models/pose_landmark_full.onnx");
@@ -16,12 +18,17 @@ const SELFIE_SEGMENTATION: &[u8] = include_bytes!("../models/selfie_segmentation
 const SELFIE_SIZE: usize = 256;
 /// Two people whose boxes are this close in area are too alike to pick between.
 const SAME_SIZE: f32 = 0.85;
+/// Two readings whose body crops' centres are closer than this fraction of the crop's side are
+/// of one person.
+const SAME_PLACE: f32 = 0.25;
 
 /// The three networks, ready to run.
 pub struct PersonModels {
     pub detector: Network,
     pub landmarker: Network,
     pub segmenter: Network,
+    /// BlazeFace, whose faces seed the search for a body the pose detector misses.
+    pub face_detector: Network,
 }
 
 /// One person found in a picture.
@@ -37,14 +44,74 @@ impl PersonModels {
             detector: Network::load("pose_detection", POSE_DETECTION)?,
             landmarker: Network::load("pose_landmark_full", POSE_LANDMARK)?,
             segmenter: Network::load("selfie_segmentation", SELFIE_SEGMENTATION)?,
+            face_detector: Network::load("face_detection_short_range", FACE_DETECTION)?,
         })
     }
 
-    /// Everyone the detector finds whose landmark crop the landmarker confirms, largest box
-    /// first.
+    /// Everyone found in the picture, largest box first: those the detector finds in the whole
+    /// picture; where it finds nobody, those it finds in overlapping square parts of it
+    /// ([`PersonModels::in_windows`]); where that finds nobody either, the bodies below the faces
+    /// BlazeFace finds ([`PersonModels::below_faces`]). The landmarker confirms each.
     pub fn people(&self, image: &Image) -> Result<Vec<Person>, FitError> {
+        let found = self.in_whole_picture(image)?;
+        if !found.is_empty() {
+            return Ok(found);
+        }
+        let found = self.in_windows(image)?;
+        if !found.is_empty() {
+            return Ok(found);
+        }
+        self.below_faces(image)
+    }
+
+    /// Everyone the detector finds in the whole picture (letterboxed) whose landmark crop the
+    /// landmarker confirms, largest box first: what MediaPipe's own pipeline finds.
+    pub fn in_whole_picture(&self, image: &Image) -> Result<Vec<Person>, FitError> {
+        self.confirmed(image, POSE.detect(&self.detector, image)?)
+    }
+
+    /// Everyone the detector finds in the overlapping square windows of [`windows`] (two or
+    /// three scales), the windows' detections merged where they overlap, each confirmed by the
+    /// landmarker.
+    pub fn in_windows(&self, image: &Image) -> Result<Vec<Person>, FitError> {
+        let mut candidates = Vec::new();
+        for window in windows(image.width, image.height) {
+            candidates.extend(POSE.detect_in(&self.detector, image, &window)?);
+        }
+        Ok(distinct(self.confirmed(image, suppress(candidates))?))
+    }
+
+    /// The bodies below the faces BlazeFace finds in the whole picture and in the windows of
+    /// [`windows`]: for each face, the landmarks read in the body regions [`body_seeds`]
+    /// proposes, the surest kept where the landmarker confirms it. The person's box is the face's,
+    /// as the pose detector's own box is.
+    pub fn below_faces(&self, image: &Image) -> Result<Vec<Person>, FitError> {
+        let mut faces = FACE.detect(&self.face_detector, image)?;
+        for window in windows(image.width, image.height) {
+            faces.extend(FACE.detect_in(&self.face_detector, image, &window)?);
+        }
         let mut out = Vec::new();
-        for detection in POSE.detect(&self.detector, image)? {
+        for face in suppress(faces) {
+            let mut best: Option<Person> = None;
+            for [hip, scale] in body_seeds(&face) {
+                let landmarks = estimate(&self.landmarker, image, aligned_roi(hip, scale))?;
+                if landmarks.flag >= MIN_POSE_FLAG
+                    && best.as_ref().is_none_or(|b| landmarks.flag > b.landmarks.flag)
+                {
+                    let detection = Detection { keypoints: vec![hip, scale], ..face.clone() };
+                    best = Some(Person { detection, landmarks });
+                }
+            }
+            out.extend(best);
+        }
+        out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
+        Ok(out)
+    }
+
+    /// The detections whose landmark crop the landmarker confirms, largest box first.
+    fn confirmed(&self, image: &Image, detections: Vec<Detection>) -> Result<Vec<Person>, FitError> {
+        let mut out = Vec::new();
+        for detection in detections {
             let landmarks = estimate(&self.landmarker, image, detection_roi(&detection))?;
             if landmarks.flag >= MIN_POSE_FLAG {
                 out.push(Person { detection, landmarks });
@@ -77,6 +144,27 @@ impl PersonModels {
         let mask = &out[self.segmenter.output_index("mask")?].values;
         Ok(uncrop(mask, SELFIE_SIZE, &lb, image.width, image.height))
     }
+}
+
+/// `people` less those read twice: windows of two scales can give the same person two detection
+/// boxes too unlike to merge (one the face, one the head), but the landmarks read from both put
+/// the body in the same place ([`PoseLandmarks::next_roi`], the crop the whole body sets). The
+/// surer reading is kept; largest box first.
+fn distinct(mut people: Vec<Person>) -> Vec<Person> {
+    people.sort_by(|a, b| b.landmarks.flag.total_cmp(&a.landmarks.flag));
+    let mut out: Vec<Person> = Vec::new();
+    for person in people {
+        let r = person.landmarks.next_roi;
+        let same = |o: &Person| {
+            let q = o.landmarks.next_roi;
+            (r.cx - q.cx).hypot(r.cy - q.cy) < SAME_PLACE * r.width.min(q.width)
+        };
+        if !out.iter().any(same) {
+            out.push(person);
+        }
+    }
+    out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
+    out
 }
 
 /// The person `wanted` names (counting from 0, largest first), else the only or clearly largest

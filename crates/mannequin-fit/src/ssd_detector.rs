@@ -51,7 +51,8 @@ impl Detection {
         (self.bbox[2] - self.bbox[0]).max(0.0) * (self.bbox[3] - self.bbox[1]).max(0.0)
     }
 
-    fn iou(&self, other: &Self) -> f32 {
+    /// Intersection over union of the two boxes.
+    pub fn iou(&self, other: &Self) -> f32 {
         let w = (self.bbox[2].min(other.bbox[2]) - self.bbox[0].max(other.bbox[0])).max(0.0);
         let h = (self.bbox[3].min(other.bbox[3]) - self.bbox[1].max(other.bbox[1])).max(0.0);
         let inter = w * h;
@@ -99,10 +100,12 @@ impl Ssd {
 
     /// The input tensor for an image: the letterbox, RGB in [−1, 1].
     pub fn input(&self, image: &Image) -> Vec<f32> {
-        crop(image, &letterbox(image), self.input_size, Border::Zero)
-            .into_iter()
-            .map(|v| v * 2.0 - 1.0)
-            .collect()
+        self.input_in(image, &letterbox(image))
+    }
+
+    /// The input tensor for a square `region` of an image, RGB in [−1, 1].
+    fn input_in(&self, image: &Image, region: &RotatedRect) -> Vec<f32> {
+        crop(image, region, self.input_size, Border::Zero).into_iter().map(|v| v * 2.0 - 1.0).collect()
     }
 
     /// Candidates above [`MIN_SCORE`], decoded from the raw outputs into the input's [0, 1]
@@ -133,11 +136,21 @@ impl Ssd {
 
     /// Everything the detector finds in the image, best score first, in image pixels.
     pub fn detect(&self, network: &Network, image: &Image) -> Result<Vec<Detection>, FitError> {
-        let out = network.run(self.input(image))?;
+        self.detect_in(network, image, &letterbox(image))
+    }
+
+    /// Everything the detector finds in a square `region` of the image (read as if it were the
+    /// whole picture), best score first, in image pixels.
+    pub fn detect_in(
+        &self,
+        network: &Network,
+        image: &Image,
+        region: &RotatedRect,
+    ) -> Result<Vec<Detection>, FitError> {
+        let out = network.run(self.input_in(image, region))?;
         let regressors = &out[network.output_index("regressors")?].values;
         let scores = &out[network.output_index("scores")?].values;
-        let lb = letterbox(image);
-        Ok(suppress(self.decode(regressors, scores)).iter().map(|d| to_image(d, &lb)).collect())
+        Ok(suppress(self.decode(regressors, scores)).iter().map(|d| to_image(d, region)).collect())
     }
 }
 
@@ -164,9 +177,9 @@ pub fn suppress(mut candidates: Vec<Detection>) -> Vec<Detection> {
     out
 }
 
-/// Maps a detection from the letterbox's [0, 1] square into image pixels.
-fn to_image(d: &Detection, letterbox: &RotatedRect) -> Detection {
-    let map = |x: f32, y: f32| letterbox.to_image(x, y, 1);
+/// Maps a detection from the [0, 1] square of the region the detector read into image pixels.
+fn to_image(d: &Detection, region: &RotatedRect) -> Detection {
+    let map = |x: f32, y: f32| region.to_image(x, y, 1);
     let [x0, y0] = map(d.bbox[0], d.bbox[1]);
     let [x1, y1] = map(d.bbox[2], d.bbox[3]);
     Detection {
