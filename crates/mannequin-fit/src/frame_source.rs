@@ -43,11 +43,12 @@ impl FrameSource {
             return Err(FitError::Setting(format!("--fps {fps}: expected a positive frame rate")));
         }
         let (dir, decoded) = match (&self.video, &self.frames) {
-            (Some(video), _) => (decode_video(video, self.fps, scratch)?, true),
+            (Some(video), _) => (self.decode(video, scratch)?, true),
             (None, Some(dir)) => (dir.clone(), false),
             (None, None) => return Err(FitError::Setting("give --frames DIR or --video FILE".into())),
         };
         let mut files = image_files(&dir)?;
+        // ffmpeg decoded no more than these already; a folder's extra files are left unread.
         if let Some(n) = self.max_frames {
             files.truncate(n);
         }
@@ -62,45 +63,49 @@ impl FrameSource {
             None => files.iter().map(|f| Ok(format!("{} {}", f.display(), file_hash(f)?))).collect(),
         }
     }
+
+    /// Decodes the frames used of `video` (at `--fps`, at most `--max-frames` of them) into PNG
+    /// frames under `out/.frames` with ffmpeg: a long video is not decoded whole to use its start.
+    fn decode(&self, video: &Path, out: &Path) -> Result<PathBuf, FitError> {
+        if !video.is_file() {
+            return Err(FitError::input(video.display().to_string(), "no such video file"));
+        }
+        let dir = out.join(".frames");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).map_err(FitError::file("creating", &dir))?;
+        let mut cmd = Command::new("ffmpeg");
+        cmd.args(["-loglevel", "error", "-i"]).arg(video);
+        if let Some(f) = self.fps {
+            cmd.args(["-vf", &format!("fps={f}")]);
+        }
+        if let Some(n) = self.max_frames {
+            cmd.args(["-frames:v", &n.to_string()]);
+        }
+        let status = match cmd.arg(dir.join("%06d.png")).status() {
+            Ok(s) => s,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(FitError::Setting(
+                    "--video needs the ffmpeg program, which is not on PATH: install it (Debian/Ubuntu: \
+                     sudo apt-get install ffmpeg; macOS: brew install ffmpeg), or pass --frames DIR with the frames as images"
+                        .into(),
+                ));
+            }
+            Err(e) => return Err(FitError::file("running", "ffmpeg")(e)),
+        };
+        if !status.success() {
+            return Err(FitError::input(
+                video.display().to_string(),
+                format!("ffmpeg could not decode it ({status})"),
+            ));
+        }
+        Ok(dir)
+    }
 }
 
 /// The hash of a file's bytes: tells an edited input from the one a checkpoint ran.
 fn file_hash(path: &Path) -> Result<String, FitError> {
     let bytes = std::fs::read(path).map_err(FitError::file("reading", path))?;
     Ok(mannequin_io::fingerprint::hash_bytes(&bytes))
-}
-
-/// Decodes `video` into PNG frames under `out/.frames` with ffmpeg.
-fn decode_video(video: &Path, fps: Option<f64>, out: &Path) -> Result<PathBuf, FitError> {
-    if !video.is_file() {
-        return Err(FitError::input(video.display().to_string(), "no such video file"));
-    }
-    let dir = out.join(".frames");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).map_err(FitError::file("creating", &dir))?;
-    let mut cmd = Command::new("ffmpeg");
-    cmd.args(["-loglevel", "error", "-i"]).arg(video);
-    if let Some(f) = fps {
-        cmd.args(["-vf", &format!("fps={f}")]);
-    }
-    let status = match cmd.arg(dir.join("%06d.png")).status() {
-        Ok(s) => s,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(FitError::Setting(
-                "--video needs the ffmpeg program, which is not on PATH: install it (Debian/Ubuntu: \
-                 sudo apt-get install ffmpeg; macOS: brew install ffmpeg), or pass --frames DIR with the frames as images"
-                    .into(),
-            ));
-        }
-        Err(e) => return Err(FitError::file("running", "ffmpeg")(e)),
-    };
-    if !status.success() {
-        return Err(FitError::input(
-            video.display().to_string(),
-            format!("ffmpeg could not decode it ({status})"),
-        ));
-    }
-    Ok(dir)
 }
 
 /// The image files of a folder, in name order.
