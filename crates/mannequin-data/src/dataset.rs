@@ -13,6 +13,7 @@ use crate::frame_files::{ImageFiles, list_frame_files};
 use crate::image::{Image, Mask};
 use crate::layout;
 use crate::maps::{DepthMap, NormalMap, read_mask_npy};
+use crate::origin::Origin;
 use crate::poses::Poses;
 use crate::splits::{SplitRange, Splits, read_splits_json, standard_splits};
 
@@ -126,6 +127,8 @@ pub struct Dataset {
     pub has_normals: bool,
     pub has_depth: bool,
     pub has_meshes: bool,
+    /// Where the poses came from, where the dataset says (`origin.json`).
+    pub origin: Option<Origin>,
     native: Camera,
     /// The extension the images share (`png`, `jpg` or `jpeg`).
     image_ext: &'static str,
@@ -220,6 +223,7 @@ impl Dataset {
             has_normals: root.join(layout::NORMALS).is_dir(),
             has_depth: root.join(layout::DEPTH).is_dir(),
             has_meshes: root.join(layout::MESHES).is_dir(),
+            origin: Origin::read(&root)?,
             native,
             image_ext: images.ext,
             root,

@@ -52,6 +52,24 @@ pub struct FrameScores {
     pub garments: BTreeMap<String, GeometryMetrics>,
 }
 
+/// The poses a test set was rendered at: the dataset's as they are, or each fitted to its test
+/// image with the avatar frozen (the peers' protocol for estimated poses), in so many steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(tag = "mode", rename_all = "kebab-case")]
+pub enum TestPoses {
+    AsIs,
+    Fit { steps: usize },
+}
+
+impl std::fmt::Display for TestPoses {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::AsIs => write!(f, "the dataset's poses as they are"),
+            Self::Fit { steps } => write!(f, "each pose fitted to its image in {steps} steps"),
+        }
+    }
+}
+
 /// Means over frames (over the frames that have the metric, for the optional ones).
 #[derive(Debug, Clone, Serialize)]
 pub struct EvalSummary {
@@ -60,6 +78,8 @@ pub struct EvalSummary {
     pub background: [f32; 3],
     pub gt_downscale: usize,
     pub frames: usize,
+    /// Whether the renders' poses were the dataset's or fitted to each test image first.
+    pub test_poses: TestPoses,
     pub psnr: f64,
     pub ssim: f64,
     pub lpips: Option<f64>,
@@ -279,6 +299,7 @@ pub fn evaluate(
         background: opt.background,
         gt_downscale,
         frames: per_frame.len(),
+        test_poses: TestPoses::AsIs,
         psnr: mean(per_frame.iter().map(|s| s.psnr)),
         ssim: mean(per_frame.iter().map(|s| s.ssim)),
         lpips: mean_of(&per_frame, |s| s.lpips),

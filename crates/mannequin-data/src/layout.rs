@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 pub const CAMERAS: &str = "cameras.npz";
 pub const SPLITS: &str = "splits.json";
+/// Where the poses came from (`crate::origin`).
+pub const ORIGIN: &str = "origin.json";
 pub const IMAGES: &str = "images";
 pub const MASKS: &str = "masks";
 pub const NORMALS: &str = "normals";

@@ -12,6 +12,7 @@ pub mod labels;
 pub mod layout;
 pub mod maps;
 pub mod metrics;
+pub mod origin;
 pub mod poses;
 pub mod scores;
 pub mod splits;
@@ -23,7 +24,9 @@ pub use image::{Image, Mask};
 /// The one camera type of the project, shared with the renderer.
 pub use mannequin_splat::Camera;
 pub use maps::{DepthMap, NormalMap};
+pub use origin::{Origin, PoseOrigin};
 pub use poses::Poses;
+pub use evaluation::TestPoses;
 pub use scores::{Scores, TestSet};
 pub use splits::{SplitRange, Splits, standard_splits};
 pub use writer::DatasetWriter;

@@ -12,6 +12,7 @@ use crate::image::Mask;
 use crate::labels::LabelMap;
 use crate::layout;
 use crate::maps::write_mask_npy;
+use crate::origin::{Origin, PoseOrigin};
 use crate::poses::Poses;
 use crate::splits::{Splits, write_splits_json};
 
@@ -52,6 +53,11 @@ impl DatasetWriter {
 
     pub fn write_splits(&self, splits: &Splits) -> Result<(), DataError> {
         write_splits_json(&self.root.join(layout::SPLITS), splits)
+    }
+
+    /// Records where the dataset's poses came from (`origin.json`).
+    pub fn write_origin(&self, poses: PoseOrigin, by: &str) -> Result<(), DataError> {
+        Origin { poses, by: by.to_string() }.write(&self.root)
     }
 
     pub fn write_poses(&self, split: &str, poses: &Poses) -> Result<(), DataError> {

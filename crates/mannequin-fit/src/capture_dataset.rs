@@ -8,7 +8,7 @@ use glam::{DMat3, DMat4, DVec3};
 use mannequin_body::BodyModel;
 use mannequin_body::rodrigues::axis_angle_quat;
 use mannequin_data::splits::SplitRange;
-use mannequin_data::{Camera, Cameras, DatasetWriter, Poses, Splits};
+use mannequin_data::{Camera, Cameras, DatasetWriter, PoseOrigin, Poses, Splits};
 
 use crate::body_fit::BodyFit;
 use crate::error::FitError;
@@ -49,6 +49,7 @@ pub(crate) fn write_dataset(
         writer.write_poses(name, &all.select(&range.frames()))?;
     }
     writer.write_splits(&splits)?;
+    writer.write_origin(PoseOrigin::Estimated, "mannequin capture")?;
     Ok(())
 }
 

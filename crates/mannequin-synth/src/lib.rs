@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use mannequin_body::BodyModel;
-use mannequin_data::Camera;
+use mannequin_data::{Camera, PoseOrigin};
 use mannequin_data::dataset::{Cameras, Frame};
 use mannequin_data::poses::{BODY_POSE_LEN, Poses};
 use mannequin_data::splits::{SplitRange, Splits};
@@ -32,6 +32,8 @@ use subject::Subject;
 const CAPTURE_FPS: f32 = 30.0;
 /// Poses the cloth simulator sees per frame of the out-of-distribution motions (about 30 fps).
 const NOVEL_SUBFRAMES: usize = 4;
+/// What `origin.json` names as the dataset's writer.
+const SYNTHESISED_BY: &str = "mannequin synth";
 
 /// Sizes of the generated dataset.
 #[derive(Debug, Clone, Serialize)]
@@ -186,6 +188,7 @@ pub fn generate(
         ]
         .into(),
     )?;
+    root.write_origin(PoseOrigin::Truth, SYNTHESISED_BY)?;
     let all = split_poses(&subject.betas, &capture_poses, &capture.transl);
     root.write_poses("train", &all.select(&(0..train).collect::<Vec<_>>()))?;
     root.write_poses("val", &all.select(&[train]))?;
@@ -215,6 +218,7 @@ pub fn generate(
     let nv = DatasetWriter::new(out.join("test/novel_view"));
     nv.write_cameras(&Cameras::PerFrame(view_cameras.clone()))?;
     nv.write_splits(&one_split("test", views.len()))?;
+    nv.write_origin(PoseOrigin::Truth, SYNTHESISED_BY)?;
     nv.write_poses("test", &split_poses(&subject.betas, &view_poses, &views.transl))?;
     write_frames(&scene, &views, &view_cameras, &nv, options.supersample, on_frame)?;
 
@@ -222,6 +226,7 @@ pub fn generate(
     let np = DatasetWriter::new(out.join("test/novel_pose"));
     np.write_cameras(&Cameras::Static(camera.clone()))?;
     np.write_splits(&one_split("test", novel.len()))?;
+    np.write_origin(PoseOrigin::Truth, SYNTHESISED_BY)?;
     np.write_poses("test", &split_poses(&subject.betas, &novel_poses, &novel.transl))?;
     write_frames(&scene, &novel, &vec![camera; novel.len()], &np, options.supersample, on_frame)?;
 
