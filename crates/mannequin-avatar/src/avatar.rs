@@ -238,21 +238,22 @@ impl Avatar {
         if let Some(i) = pose.iter().chain(&transl).position(|x| !x.is_finite()) {
             return Err(AvatarError::Invalid(format!("pose value {i} is not finite")));
         }
-        let v = self.canonical.num_vertices();
+        let pose = tensor_from(pose.to_vec(), 1, 3 * j, &self.device);
+        Ok(self.skin_tensor(personalised, pose, tensor_from(transl.to_vec(), 1, 3, &self.device)))
+    }
+
+    /// [`Avatar::skin`] with the pose [1, 3J] and translation [1, 3] as tensors, so that
+    /// gradients reach them (pose refinement).
+    pub fn skin_tensor(&self, personalised: Tensor<2>, pose: Tensor<2>, transl: Tensor<2>) -> Tensor<2> {
+        let (v, j) = (self.canonical.num_vertices(), self.canonical.num_joints());
         let joints = self.param(self.slots.joints).unwrap_or_else(|| self.rest_joints.clone());
         let rig = Rig {
             weights: &self.weights,
             posedirs: self.posedirs.as_ref(),
             parents: &self.canonical.parents,
         };
-        let posed = skin_tensors(
-            &rig,
-            personalised.reshape([1, v, 3]),
-            joints.reshape([1, j, 3]),
-            tensor_from(pose.to_vec(), 1, 3 * j, &self.device),
-            tensor_from(transl.to_vec(), 1, 3, &self.device),
-        );
-        Ok(posed.vertices.reshape([v, 3]))
+        let posed = skin_tensors(&rig, personalised.reshape([1, v, 3]), joints.reshape([1, j, 3]), pose, transl);
+        posed.vertices.reshape([v, 3])
     }
 
     /// Poses the avatar and binds its Gaussians.

@@ -23,6 +23,8 @@ pub enum AvatarError {
     Invalid(String),
     #[error("the loss became {value} at iteration {iteration}; the last good checkpoint is {checkpoint}")]
     NonFiniteLoss { iteration: usize, value: f64, checkpoint: String },
+    #[error("the refined pose of frame {frame} stopped being finite; the last good checkpoint is {checkpoint}")]
+    NonFinitePose { frame: usize, checkpoint: String },
     /// A checkpoint that cannot be resumed, with the way out.
     #[error("{0}; {START_OVER}")]
     CannotResume(Box<AvatarError>),
@@ -31,6 +33,15 @@ pub enum AvatarError {
 impl AvatarError {
     pub fn file(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
         Self::File { path: path.into(), reason: reason.into() }
+    }
+
+    /// A training error with the last good checkpoint named where it stops a run.
+    pub fn with_checkpoint(self, last: String) -> Self {
+        match self {
+            Self::NonFiniteLoss { iteration, value, .. } => Self::NonFiniteLoss { iteration, value, checkpoint: last },
+            Self::NonFinitePose { frame, .. } => Self::NonFinitePose { frame, checkpoint: last },
+            e => e,
+        }
     }
 
     /// This error, refusing a checkpoint, with the way out.

@@ -29,6 +29,7 @@ pub mod mlp;
 pub mod one_ring_mesh;
 pub mod options;
 pub mod params;
+pub mod pose_refinement;
 pub mod predict;
 pub mod render_map;
 pub mod run;
@@ -38,6 +39,7 @@ pub mod skirt_layer;
 pub mod subject_mesh;
 pub mod trainer;
 pub mod training;
+pub mod view_loss;
 pub mod views;
 
 pub use avatar::{Avatar, Posed, Rendered};

@@ -38,6 +38,11 @@ pub struct TrainOptions {
     pub final_lr_factor: f64,
     /// Share of the iterations, from the start, on views at half resolution (0: none).
     pub half_resolution_share: f64,
+    /// Whether each training frame's pose is refined with the avatar (`train --refine-poses`,
+    /// resolved against the dataset's origin). Recorded only when on, so checkpoints from before
+    /// refinement still resume.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub refine_poses: bool,
 }
 
 impl TrainOptions {
@@ -54,6 +59,7 @@ impl TrainOptions {
             lambda_mask: 0.1,
             final_lr_factor: FINAL_LR_FACTOR,
             half_resolution_share: HALF_RESOLUTION_SHARE,
+            refine_poses: false,
         }
     }
 }

@@ -8,6 +8,7 @@ use crate::canonical::MAX_SUBDIVISIONS;
 use crate::compute::Compute;
 use crate::config::{AVATAR_DILATION, AvatarConfig, Method};
 use crate::options::TrainOptions;
+use crate::pose_refinement::RefinePoses;
 use crate::skirt_layer::SkirtMode;
 
 /// What a training run is asked for, beyond where its data and avatar lie.
@@ -61,6 +62,10 @@ pub struct TrainSettings {
     /// mid-thigh) or off.
     #[arg(long, value_enum, default_value_t = TrainSettings::default().skirt)]
     pub skirt: SkirtMode,
+    /// Refine each training frame's pose with the avatar: auto does for datasets whose poses
+    /// were estimated (`mannequin capture` writes such), not for ground-truth poses.
+    #[arg(long, value_enum, default_value_t = TrainSettings::default().refine_poses)]
+    pub refine_poses: RefinePoses,
     /// Where training runs: cpu (Flex) or gpu (wgpu on Vulkan).
     #[arg(long, value_enum, default_value_t = TrainSettings::default().device)]
     pub device: Compute,
@@ -85,6 +90,7 @@ impl Default for TrainSettings {
             antialiased: false,
             dilation: AVATAR_DILATION,
             skirt: SkirtMode::Auto,
+            refine_poses: RefinePoses::Auto,
             device: Compute::Cpu,
             restart: false,
         }

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use burn::tensor::{Gradients, Tensor, TensorData};
+use burn::tensor::{Gradients, Tensor};
 use mannequin_io::rng::SplitMix64;
 use mannequin_io::{NpyArray, NpzWriter};
 
@@ -13,9 +13,11 @@ use crate::avatar::Avatar;
 use crate::checkpoint::Checkpoint;
 use crate::config::Method;
 use crate::error::AvatarError;
-use crate::losses::{MeshRegularisers, photometric_weighted};
+use crate::losses::MeshRegularisers;
 use crate::options::TrainOptions;
+use crate::pose_refinement::{PoseRefinement, START_SHARE};
 use crate::run::TrainingRun;
+use crate::view_loss::view_loss;
 use crate::views::View;
 
 /// Wall time of each phase of one iteration, for the benchmark's breakdown.
@@ -53,6 +55,8 @@ pub struct Trainer {
     laplacian_scale: f64,
     /// Each parameter's learning rate at iteration 0.
     base_lr: Vec<f64>,
+    /// Each training view's pose as a parameter, where the run refines them.
+    refinement: Option<PoseRefinement>,
     /// Wait for the device at each phase boundary, so that [`Timings`] charges each phase its
     /// own work on a GPU, whose launches return before the work is done (costs throughput).
     pub profile: bool,
@@ -81,15 +85,6 @@ fn epoch_order(seed: u64, epoch: usize, n: usize) -> Vec<usize> {
     order
 }
 
-fn image_tensor(
-    values: &[f32],
-    channels: usize,
-    crop: &crate::views::Crop,
-    device: &burn::tensor::Device,
-) -> Tensor<3> {
-    Tensor::from_data(TensorData::new(values.to_vec(), [channels, crop.height, crop.width]), device)
-}
-
 impl Trainer {
     pub fn new(avatar: Avatar, views: Vec<View>, options: TrainOptions) -> Result<Self, AvatarError> {
         if views.is_empty() {
@@ -108,7 +103,9 @@ impl Trainer {
         } else {
             Vec::new()
         };
+        let refinement = options.refine_poses.then(|| PoseRefinement::new(&views, avatar.device()));
         Ok(Self {
+            refinement,
             avatar,
             options,
             iteration: 0,
@@ -134,8 +131,7 @@ impl Trainer {
     /// displacement encoder learns fastest in stage 2, joints freeze in stage 3.
     fn apply_schedule(&mut self) {
         if self.avatar.config.method != Method::Ihuman {
-            let t = self.iteration as f64 / self.options.iterations.max(1) as f64;
-            let factor = self.options.final_lr_factor.powf(t);
+            let factor = self.lr_factor();
             for (p, base) in self.avatar.params.iter_mut().zip(&self.base_lr) {
                 p.lr = base * factor;
             }
@@ -171,12 +167,29 @@ impl Trainer {
         }
     }
 
+    /// Tavatar's learning rates, and the refined poses', decay exponentially to
+    /// `final_lr_factor` of their start over the run.
+    fn lr_factor(&self) -> f64 {
+        let t = self.iteration as f64 / self.options.iterations.max(1) as f64;
+        self.options.final_lr_factor.powf(t)
+    }
+
+    /// Whether this iteration moves the poses (refinement starts after `START_SHARE`).
+    fn refining(&self) -> bool {
+        self.refinement.is_some()
+            && self.iteration as f64 >= START_SHARE * self.options.iterations as f64
+    }
+
     /// One iteration on the next view.
     pub fn step(&mut self) -> Result<StepStats, AvatarError> {
         self.apply_schedule();
-        let (grads, value, psnr, mut t) = self.loss_and_gradients()?;
+        let (grads, value, psnr, k, mut t) = self.loss_and_gradients()?;
         let clock = Instant::now();
         self.adam.update(&mut self.avatar.params, &grads);
+        let factor = self.lr_factor();
+        if let Some(r) = &mut self.refinement {
+            r.update(&grads, factor, k)?;
+        }
         t.optimiser = self.lap(clock)?;
         self.iteration += 1;
         Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
@@ -193,24 +206,31 @@ impl Trainer {
         Ok(clock.elapsed())
     }
 
-    /// This iteration's gradients, loss and PSNR. Every forward tensor is dropped on return, so
-    /// the optimiser finds the parameters' buffers unshared and updates them in place.
-    fn loss_and_gradients(&self) -> Result<(Gradients, f64, f64, Timings), AvatarError> {
+    /// This iteration's gradients, loss, PSNR and view. Every forward tensor is dropped on
+    /// return, so the optimiser finds the parameters' buffers unshared and updates them in place.
+    fn loss_and_gradients(&self) -> Result<(Gradients, f64, f64, usize, Timings), AvatarError> {
         let n = self.views.len();
         let (epoch, k) = (self.iteration / n, self.iteration % n);
         let coarse =
             (self.iteration as f64) < self.options.half_resolution_share * self.options.iterations as f64;
         let views = if coarse { &self.halved } else { &self.views };
-        let view = &views[epoch_order(self.options.seed, epoch, n)[k]];
-        let device = self.avatar.device().clone();
+        let k = epoch_order(self.options.seed, epoch, n)[k];
+        let view = &views[k];
         let o = &self.options;
+        let refining = self.refining();
         let mut t = Timings::default();
 
         self.lap(Instant::now())?;
         let clock = Instant::now();
         let offsets = self.avatar.offsets()?;
         let personalised = self.avatar.personalised(offsets.clone());
-        let vertices = self.avatar.skin(personalised.clone(), &view.pose, view.transl)?;
+        let vertices = match &self.refinement {
+            Some(r) => {
+                let (pose, transl) = r.pose(k, refining);
+                self.avatar.skin_tensor(personalised.clone(), pose, transl)
+            }
+            None => self.avatar.skin(personalised.clone(), &view.pose, view.transl)?,
+        };
         t.skinning = self.lap(clock)?;
         let clock = Instant::now();
         let gaussians = self.avatar.bind(&vertices);
@@ -218,31 +238,20 @@ impl Trainer {
         let clock = Instant::now();
         let posed = crate::avatar::Posed { personalised: personalised.clone(), vertices, gaussians };
         // Only the crop is rendered: the losses look nowhere else.
-        let crop = &view.crop;
         let r = self.avatar.render(&posed, &view.crop_camera())?;
         t.render = self.lap(clock)?;
 
         let clock = Instant::now();
-        let target = image_tensor(&view.targets, view.target_channels(), crop, &device);
-        // Eq. 12 on colour and Eq. 13 on normals in one pass over the stacked image.
-        let (pred, weights) = if view.has_normals() {
-            let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);
-            (r.image.clone(), w.collect())
-        } else {
-            (r.rgb(), vec![1.0 / 3.0; 3])
-        };
-        let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
-        let mut loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
-        let alpha = r.alpha;
-        let mask: Tensor<2> =
-            Tensor::from_data(TensorData::new(view.mask.clone(), [crop.height, crop.width]), &device);
-        loss = loss + (alpha - mask).abs().mean() * o.lambda_mask;
+        let (mut loss, mse) = view_loss(&r, view, o)?;
         // Laplacian smoothness of the offset field and normal consistency of V_s (Eq. 15).
         let mesh = self.regularisers.laplacian(offsets)? * self.laplacian_scale
             + self.regularisers.normal_consistency(personalised.clone())?;
         loss = loss + mesh * o.lambda_mesh;
         if o.lambda_equilateral > 0.0 {
             loss = loss + self.regularisers.equilateral(personalised)? * o.lambda_equilateral;
+        }
+        if let Some(r) = self.refinement.as_ref().filter(|_| refining) {
+            loss = loss + r.prior(k);
         }
         let value = loss.clone().into_scalar::<f64>();
         t.losses = self.lap(clock)?;
@@ -258,7 +267,12 @@ impl Trainer {
         let clock = Instant::now();
         let grads = loss.backward();
         t.backward = self.lap(clock)?;
-        Ok((grads, value, psnr, t))
+        Ok((grads, value, psnr, k, t))
+    }
+
+    /// The refined training poses with the dataset's `betas`, where the run refines them.
+    pub fn refined_poses(&self, betas: &[f32]) -> Option<mannequin_data::Poses> {
+        self.refinement.as_ref().map(|r| r.poses(betas))
     }
 
     /// Mean wall time of the splatting backward alone (Gaussians as leaves) on the first view,
@@ -295,7 +309,10 @@ impl Trainer {
         for p in &self.avatar.params {
             p.save(&mut w, "param/");
         }
-        self.adam.save(&self.avatar.params, &mut w);
+        self.adam.save(&self.avatar.params, &mut w, "");
+        if let Some(r) = &self.refinement {
+            r.save(&mut w);
+        }
         w.write(path)?;
         Ok(())
     }
@@ -306,7 +323,10 @@ impl Trainer {
         let npz = &checkpoint.npz;
         run.check(npz, &[])?;
         self.avatar.load_params(npz, "param/")?;
-        self.adam = Adam::load(&self.avatar.params, npz, checkpoint.iteration)?;
+        self.adam = Adam::load(&self.avatar.params, npz, checkpoint.iteration, "")?;
+        if let Some(r) = &mut self.refinement {
+            r.load(npz, checkpoint.iteration)?;
+        }
         self.iteration = checkpoint.iteration;
         Ok(())
     }

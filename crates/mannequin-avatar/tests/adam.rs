@@ -166,7 +166,7 @@ fn checkpoint(params: &[Param], adam: &Adam) -> Npz {
     for p in params {
         p.save(&mut w, "param/");
     }
-    adam.save(params, &mut w);
+    adam.save(params, &mut w, "");
     Npz::from_bytes(PathBuf::from("memory.npz"), &w.to_bytes()).unwrap()
 }
 
@@ -240,7 +240,7 @@ fn a_saved_and_loaded_optimiser_continues_bit_for_bit() {
     for p in &mut resumed {
         p.load(&saved, "param/", FLOAT32).unwrap();
     }
-    let mut adam = Adam::load(&resumed, &saved, 2).unwrap();
+    let mut adam = Adam::load(&resumed, &saved, 2, "").unwrap();
     train(&mut resumed, &mut adam, 3..=5);
     let found = checkpoint(&resumed, &adam);
 

@@ -140,7 +140,7 @@ fn a_run_trains_to_its_iterations_and_saves_the_avatar() {
     let out = data.join("model");
     let trainer = trainer(&data, Method::Tavatar, 3);
     let run = record(&trainer, &data);
-    Training { trainer, record: run.clone(), checkpoint_every: 2, out: out.clone() }.run().unwrap();
+    Training { trainer, record: run.clone(), checkpoint_every: 2, out: out.clone(), betas: Vec::new() }.run().unwrap();
     assert_eq!(Checkpoint::open(&checkpoint_path(&out), &run, &[]).unwrap().iteration, 3);
     assert!(Avatar::load(&out, &Device::flex()).is_ok(), "no avatar in {}", out.display());
     std::fs::remove_dir_all(data).ok();

@@ -49,28 +49,30 @@ impl Adam {
         }
     }
 
-    pub fn save(&self, params: &[Param], w: &mut NpzWriter) {
-        w.add("adam_step", NpyArray::i64(vec![1], vec![self.step as i64]));
+    /// Writes the step and moments as `{prefix}adam_step`, `{prefix}adam_m/<name>` and
+    /// `{prefix}adam_v/<name>`: a prefix keeps two optimisers apart in one checkpoint.
+    pub fn save(&self, params: &[Param], w: &mut NpzWriter, prefix: &str) {
+        w.add(&format!("{prefix}adam_step"), NpyArray::i64(vec![1], vec![self.step as i64]));
         for (k, p) in params.iter().enumerate() {
-            w.add(&format!("adam_m/{}", p.name), to_npy(&self.m[k]));
-            w.add(&format!("adam_v/{}", p.name), to_npy(&self.v[k]));
+            w.add(&format!("{prefix}adam_m/{}", p.name), to_npy(&self.m[k]));
+            w.add(&format!("{prefix}adam_v/{}", p.name), to_npy(&self.v[k]));
         }
     }
 
     /// Restores moments saved by [`Adam::save`] for the same parameters, `step` steps in (the
     /// caller checks it against the run). Second moments are averages of squares: a negative one
     /// is refused, as its square root would turn the next update into NaN.
-    pub fn load(params: &[Param], npz: &Npz, step: usize) -> Result<Self, AvatarError> {
+    pub fn load(params: &[Param], npz: &Npz, step: usize, prefix: &str) -> Result<Self, AvatarError> {
         let mut adam = Self::new(params);
         adam.step = step;
         for (k, p) in params.iter().enumerate() {
-            for (prefix, slot, allowed) in
+            for (moment, slot, allowed) in
                 [("adam_m/", &mut adam.m[k], FLOAT32), ("adam_v/", &mut adam.v[k], 0.0..=*FLOAT32.end())]
             {
-                let mut moment = Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
-                moment.load(npz, prefix, allowed)?;
+                let mut moment_param = Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
+                moment_param.load(npz, &format!("{prefix}{moment}"), allowed)?;
                 // Checkpoints store f32; the op wants the parameter's dtype.
-                *slot = moment.value.inner().cast(p.value.dtype());
+                *slot = moment_param.value.inner().cast(p.value.dtype());
             }
         }
         Ok(adam)

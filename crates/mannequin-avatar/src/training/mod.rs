@@ -23,12 +23,18 @@ pub struct Training {
     pub record: TrainingRun,
     pub checkpoint_every: usize,
     pub out: PathBuf,
+    /// The dataset's body shape, written with the refined poses.
+    pub betas: Vec<f32>,
 }
+
+/// The refined training poses in the model folder, in the dataset's pose format (which
+/// `animate --motion` reads).
+pub const REFINED_POSES: &str = "refined_poses.npz";
 
 impl Training {
     /// Trains to the run's last iteration with a progress bar (a log line per checkpoint where
-    /// no terminal shows it), then saves the avatar. A non-finite loss stops the run naming the
-    /// last checkpoint written.
+    /// no terminal shows it), then saves the avatar and its refined poses. A non-finite loss or
+    /// refined pose stops the run naming the last checkpoint written.
     pub fn run(mut self) -> Result<(), AvatarError> {
         let (t, iterations) = (&mut self.trainer, self.record.options.iterations);
         let checkpoint = checkpoint_path(&self.out);
@@ -36,16 +42,9 @@ impl Training {
         progress.set_position(t.iteration as u64);
         let mut running_psnr: Option<f64> = None;
         while t.iteration < iterations {
-            let stats = match t.step() {
-                Ok(s) => s,
-                Err(AvatarError::NonFiniteLoss { iteration, value, .. }) => {
-                    progress.abandon();
-                    let last =
-                        if checkpoint.exists() { checkpoint.display().to_string() } else { "none".into() };
-                    return Err(AvatarError::NonFiniteLoss { iteration, value, checkpoint: last });
-                }
-                Err(e) => return Err(e),
-            };
+            let stats = t.step().inspect_err(|_| progress.abandon()).map_err(|e| {
+                e.with_checkpoint(if checkpoint.exists() { checkpoint.display().to_string() } else { "none".into() })
+            })?;
             let p = running_psnr.map_or(stats.psnr, |r| 0.9 * r + 0.1 * stats.psnr);
             running_psnr = Some(p);
             progress.set_position(stats.iteration as u64);
@@ -64,6 +63,9 @@ impl Training {
         }
         progress.finish_and_clear();
         t.avatar.save(&self.out)?;
+        if let Some(poses) = t.refined_poses(&self.betas) {
+            poses.write(&self.out.join(REFINED_POSES))?;
+        }
         let out = self.out.display();
         match running_psnr {
             Some(p) => tracing::info!("wrote {out} (running PSNR {p:.2} dB on training crops)"),

@@ -17,6 +17,7 @@ use crate::canonical::Canonical;
 use crate::checkpoint::{Checkpoint, checkpoint_path};
 use crate::error::AvatarError;
 use crate::garment_layer::GarmentLayer;
+use crate::options::TrainOptions;
 use crate::run::{GarmentRecord, TrainingRun};
 use crate::settings::TrainSettings;
 use crate::skirt_layer::SkirtMode;
@@ -87,7 +88,10 @@ impl Subject {
                 .then_some(GarmentRecord { categories: garments.names, steps: garments.steps }),
             data: self.dataset.fingerprint(&self.split)?,
             avatar: s.avatar_config(),
-            options: s.options(),
+            options: TrainOptions {
+                refine_poses: s.refine_poses.resolve(self.dataset.origin.as_ref()),
+                ..s.options()
+            },
         };
         let checkpoint = checkpoint_path(out);
         let resume = if !s.restart && checkpoint.exists() {
@@ -107,6 +111,9 @@ impl Subject {
         let progress = bar(self.split.frames.len() as u64, "loading");
         let views = load_views(&self.dataset, &self.split, |done, _| progress.set_position(done as u64))?;
         progress.finish_and_clear();
+        if record.options.refine_poses {
+            tracing::info!("refining the {} training poses with the avatar (--refine-poses off to keep them)", views.len());
+        }
         if views.iter().any(|v| !v.has_normals()) {
             tracing::warn!("{} has no normal maps: the normal loss is off", self.data.display());
         }
@@ -152,6 +159,7 @@ impl LoadedSubject {
             trainer.num_views(),
             trainer.options.iterations
         );
-        Ok(Training { trainer, record, checkpoint_every: s.checkpoint_every, out })
+        let betas = betas.clone();
+        Ok(Training { trainer, record, checkpoint_every: s.checkpoint_every, out, betas })
     }
 }

@@ -1,0 +1,30 @@
+//! The image terms of the training loss on one view (Eq. 12 on colour, Eq. 13 on normals where
+//! the view has them, and an L1 between rendered alpha and the mask), shared by training and by
+//! fitting a test frame's pose with the avatar frozen, so both chase the same objective.
+
+use burn::tensor::{Tensor, TensorData};
+
+use crate::avatar::Rendered;
+use crate::error::AvatarError;
+use crate::losses::photometric_weighted;
+use crate::options::TrainOptions;
+use crate::views::View;
+
+/// The loss of `r` against `view`'s targets, and the colour MSE (detached, for PSNR).
+pub fn view_loss(r: &Rendered, view: &View, o: &TrainOptions) -> Result<(Tensor<1>, Tensor<1>), AvatarError> {
+    let crop = &view.crop;
+    let device = r.image.device();
+    let (channels, h, w) = (view.target_channels(), crop.height, crop.width);
+    let target: Tensor<3> = Tensor::from_data(TensorData::new(view.targets.clone(), [channels, h, w]), &device);
+    // Eq. 12 on colour and Eq. 13 on normals in one pass over the stacked image.
+    let (pred, weights) = if view.has_normals() {
+        let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);
+        (r.image.clone(), w.collect())
+    } else {
+        (r.rgb(), vec![1.0 / 3.0; 3])
+    };
+    let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
+    let loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
+    let mask: Tensor<2> = Tensor::from_data(TensorData::new(view.mask.clone(), [h, w]), &device);
+    Ok((loss + (r.alpha.clone() - mask).abs().mean() * o.lambda_mask, mse))
+}
