@@ -25,6 +25,12 @@ use crate::pose_landmarker::PoseLandmarks;
 
 /// Frames tracked between checkpoints.
 const CHECKPOINT_EVERY: usize = 10;
+/// The fewest frames a dataset can be split from: one to train on and one held out to test
+/// (the dataset holds out the last tenth, at least one).
+const MIN_FRAMES: usize = 2;
+/// A person found in fewer than this share of the clip's frames is lost for most of it: what
+/// is left is not their clip (someone else's, or a few stray frames).
+const MIN_FOUND_SHARE: f64 = 0.5;
 
 /// Everything a capture reads: its frames, the body and camera, and where it writes.
 #[derive(Clone, Debug, Default, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
@@ -41,6 +47,10 @@ pub struct CaptureSettings {
     /// camera and the body turning in front of it.
     #[arg(long)]
     pub moving_camera: bool,
+    /// Which person to capture, counting from 0 in order of size (largest first) in the first
+    /// frame anyone is found in; followed from there by where they were in the frame before.
+    #[arg(long)]
+    pub person: Option<usize>,
     /// Ignore a checkpoint in --out and start over.
     #[arg(long)]
     pub restart: bool,
@@ -52,13 +62,15 @@ pub struct CaptureSummary {
     pub left_out: usize,
 }
 
-/// Captures, and where the run fails before its first checkpoint, removes the output folder it
-/// made: nothing half-made is left to mistake for a dataset. A run with a checkpoint keeps its
-/// folder, so that running it again resumes.
+/// Captures, and where the run fails without a checkpoint to resume from, removes the output
+/// folder when it is the capture's own (made by it, or holding a capture's checkpoint): nothing
+/// half-made is left to mistake for a dataset. A run with a checkpoint keeps its folder, so that
+/// running it again resumes; a refusal that resuming cannot mend removes the checkpoint first.
 pub fn capture(settings: &CaptureSettings) -> Result<CaptureSummary, FitError> {
-    let fresh = !settings.out.exists();
+    let checkpoint = settings.out.join(CHECKPOINT);
+    let ours = !settings.out.exists() || checkpoint.exists();
     let result = capture_into(settings);
-    if result.is_err() && fresh && !settings.out.join(CHECKPOINT).exists() {
+    if result.is_err() && ours && !checkpoint.exists() {
         let _ = std::fs::remove_dir_all(&settings.out);
     }
     result
@@ -69,10 +81,17 @@ fn capture_into(settings: &CaptureSettings) -> Result<CaptureSummary, FitError> 
     let out = &settings.out;
     settings.fitting.check()?;
     let Frames { dir, files, decoded } = settings.input.frames(out)?;
-    if files.len() < 2 {
+    if files.len() < MIN_FRAMES {
+        let what = match &settings.input.video {
+            Some(video) => video.display().to_string(),
+            None => dir.display().to_string(),
+        };
         return Err(FitError::input(
-            dir.display().to_string(),
-            format!("{} frame(s); a capture needs at least 2", files.len()),
+            what,
+            format!(
+                "{} frame(s); a capture needs at least {MIN_FRAMES} (one to train on, one held out to test)",
+                files.len()
+            ),
         ));
     }
     same_size(&files)?;
@@ -82,6 +101,7 @@ fn capture_into(settings: &CaptureSettings) -> Result<CaptureSummary, FitError> 
         max_frames: settings.input.max_frames,
         body: settings.fitting.body.clone(),
         focal: settings.fitting.focal,
+        person: settings.person,
     };
     create_dir(out)?;
     let checkpoint = out.join(CHECKPOINT);
@@ -168,10 +188,8 @@ fn track(
     let progress = bar(files.len() as u64, "landmarks");
     progress.set_position(saved.tracked as u64);
     let last_kept = saved.kept.last().map(|(f, _)| f);
-    let followed = (saved.tracked > 0 && last_kept == Some(&files[saved.tracked - 1]))
-        .then(|| saved.people.last().map(|l| l.next_roi))
-        .flatten();
-    let mut tracker = Tracker::resume(models, followed);
+    let in_last_frame = saved.tracked > 0 && last_kept == Some(&files[saved.tracked - 1]);
+    let mut tracker = Tracker::resume(models, run.person, saved.people.last(), in_last_frame);
     for (i, file) in files.iter().enumerate().skip(saved.tracked) {
         let image = Image::read(file)?;
         match tracker.next(&image).map_err(|e| FitError::within(file.display().to_string(), e))? {
@@ -191,12 +209,21 @@ fn track(
         progress.inc(1);
     }
     progress.finish();
-    if saved.kept.len() < 2 {
-        return Err(FitError::Picture(format!(
-            "the person was found in {} of {} frames; a capture needs at least 2",
-            saved.kept.len(),
-            files.len()
-        )));
+    let needed = MIN_FRAMES.max((MIN_FOUND_SHARE * files.len() as f64).ceil() as usize);
+    if saved.kept.len() < needed {
+        // Resuming would refuse the same frames again: the checkpoint goes, and with it the folder.
+        let _ = std::fs::remove_file(checkpoint);
+        let first_lost = saved.skipped.first().unwrap_or(&files[0]);
+        return Err(FitError::input(
+            first_lost.display().to_string(),
+            format!(
+                "the first of {} frames without the person (found in {} of {}, a capture needs them in at least {needed}); \
+                 cut the clip to where they are, or choose who to follow with --person N",
+                saved.skipped.len(),
+                saved.kept.len(),
+                files.len()
+            ),
+        ));
     }
     write_checkpoint(checkpoint, run, saved)
 }

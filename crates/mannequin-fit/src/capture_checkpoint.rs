@@ -26,6 +26,8 @@ pub(crate) struct CaptureRun {
     pub max_frames: Option<usize>,
     pub body: String,
     pub focal: Option<f64>,
+    /// The person followed (`--person`).
+    pub person: Option<usize>,
 }
 
 /// What a capture has done so far: frames tracked (the kept ones written to the dataset as they

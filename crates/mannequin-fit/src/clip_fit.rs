@@ -1,6 +1,6 @@
 //! A clip to one person's landmarks and body per frame. The person is found in the first frame
 //! and followed as MediaPipe follows them (the next crop from this frame's auxiliary points),
-//! found again where the landmarker loses them.
+//! found again where the landmarker loses them (the one overlapping where they last were).
 //!
 //! Seen from the side or behind, the landmarker sometimes reads the person as their mirror (left
 //! and right swapped, depth turned over); the clip's turn decides which frames those are
@@ -15,11 +15,13 @@ use glam::{DQuat, DVec3};
 use mannequin_body::rodrigues::{axis_angle_quat, quat_axis_angle};
 use mannequin_data::Image;
 
+use crate::blazepose::LANDMARKS;
 use crate::body_fit::{Anchor, BodyFit, Fitter, FramePose, rotation_gap};
 use crate::crop::RotatedRect;
 use crate::error::FitError;
-use crate::person_models::{PersonModels, pick_person};
+use crate::person_models::{Person, PersonModels, pick_person};
 use crate::pose_landmarker::PoseLandmarks;
+use crate::ssd_detector::box_iou;
 
 /// Frames fitted independently to find the clip's one shape.
 const SHAPE_FRAMES: usize = 8;
@@ -96,25 +98,46 @@ fn voted_facings(facings: &[Option<DQuat>]) -> Vec<Option<DQuat>> {
         .collect()
 }
 
-/// Follows one person from frame to frame.
+/// Follows one person from frame to frame: in the crop their last landmarks point to while the
+/// landmarker still sees them there; where it loses them, the person found again whose body
+/// overlaps the box they last had most. The first frame anyone is found in picks the person:
+/// the one `--person` names, else the only or clearly largest one.
 pub struct Tracker<'a> {
     models: &'a PersonModels,
+    /// The person asked for, counting from 0, largest first, in the first frame with anyone.
+    wanted: Option<usize>,
     /// Where the last frame's landmarks put the person next.
     next_roi: Option<RotatedRect>,
+    /// The box the person's landmarks spanned in the last frame they were found in.
+    last_box: Option<[f32; 4]>,
 }
 
+/// A person found again overlaps the box they were last seen in by at least this IoU.
+const MIN_FOLLOW_IOU: f32 = 0.1;
+
 impl<'a> Tracker<'a> {
+    /// A tracker that picks the person unasked.
     pub fn new(models: &'a PersonModels) -> Self {
-        Self::resume(models, None)
+        Self::resume(models, None, None, false)
     }
 
-    /// A tracker that goes on where one stopped: `next_roi` is the last frame's next crop (None
-    /// when the person was not in it).
-    pub fn resume(models: &'a PersonModels, next_roi: Option<RotatedRect>) -> Self {
-        Self { models, next_roi }
+    /// A tracker that goes on where one stopped: `last` is the person as last found, and
+    /// `in_last_frame` whether that was in the frame just before.
+    pub fn resume(
+        models: &'a PersonModels,
+        wanted: Option<usize>,
+        last: Option<&PoseLandmarks>,
+        in_last_frame: bool,
+    ) -> Self {
+        Self {
+            models,
+            wanted,
+            next_roi: last.filter(|_| in_last_frame).map(|l| l.next_roi),
+            last_box: last.map(body_box),
+        }
     }
 
-    /// The person's landmarks in the next frame; None when nobody is there.
+    /// The person's landmarks in the next frame; None when they are not there.
     pub fn next(&mut self, image: &Image) -> Result<Option<PoseLandmarks>, FitError> {
         let followed = match self.next_roi {
             Some(roi) => self.models.follow(image, roi)?,
@@ -122,19 +145,45 @@ impl<'a> Tracker<'a> {
         };
         let found = match followed {
             Some(l) => Some(l),
-            None => {
-                let everyone = self.models.people(image)?;
-                match everyone.is_empty() {
-                    true => None,
-                    false => {
-                        Some(self.models.refine(image, pick_person(&everyone, None)?.landmarks.clone())?)
-                    }
-                }
-            }
+            None => match self.find_again(&self.models.people(image)?)? {
+                Some(person) => Some(self.models.refine(image, person.landmarks.clone())?),
+                None => None,
+            },
         };
         self.next_roi = found.as_ref().map(|l| l.next_roi);
+        if let Some(l) = &found {
+            self.last_box = Some(body_box(l));
+        }
         Ok(found)
     }
+
+    /// Which of `everyone` is the person: the first time, the one asked for (an error when
+    /// there is no such person, or when two are too alike in size to pick between unasked);
+    /// after, the one overlapping their last box most, else the one asked for, if any.
+    fn find_again<'p>(&self, everyone: &'p [Person]) -> Result<Option<&'p Person>, FitError> {
+        if everyone.is_empty() {
+            return Ok(None);
+        }
+        let Some(last) = self.last_box else { return pick_person(everyone, self.wanted).map(Some) };
+        let overlap = |p: &Person| box_iou(&body_box(&p.landmarks), &last);
+        let nearest = everyone.iter().max_by(|a, b| overlap(a).total_cmp(&overlap(b)));
+        Ok(match nearest.filter(|p| overlap(p) >= MIN_FOLLOW_IOU) {
+            Some(p) => Some(p),
+            None => match self.wanted {
+                Some(n) => everyone.get(n),
+                None => Some(pick_person(everyone, None)?),
+            },
+        })
+    }
+}
+
+/// The box a person's body landmarks span, in image pixels.
+fn body_box(l: &PoseLandmarks) -> [f32; 4] {
+    l.points[..LANDMARKS.len()]
+        .iter()
+        .fold([f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY], |[x0, y0, x1, y1], p| {
+            [x0.min(p[0]), y0.min(p[1]), x1.max(p[0]), y1.max(p[1])]
+        })
 }
 
 /// How far a clip's fit has got: the passes done, the clip's shape and each frame's pose and

@@ -175,10 +175,11 @@ pub fn pick_person(people: &[Person], wanted: Option<usize>) -> Result<&Person, 
     }
     if let Some(n) = wanted {
         return people.get(n).ok_or_else(|| {
-            FitError::input(
-                format!("--person {n}"),
-                format!("found {} people (0 to {})", people.len(), people.len() - 1),
-            )
+            let found = match people.len() {
+                1 => "found 1 person (--person 0)".to_string(),
+                k => format!("found {k} people (--person 0 to {})", k - 1),
+            };
+            FitError::input(format!("--person {n}"), found)
         });
     }
     if people.len() > 1 && people[1].detection.area() >= SAME_SIZE * people[0].detection.area() {

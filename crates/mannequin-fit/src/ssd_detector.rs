@@ -48,17 +48,26 @@ impl Detection {
     }
 
     pub fn area(&self) -> f32 {
-        (self.bbox[2] - self.bbox[0]).max(0.0) * (self.bbox[3] - self.bbox[1]).max(0.0)
+        box_area(&self.bbox)
     }
 
     /// Intersection over union of the two boxes.
     pub fn iou(&self, other: &Self) -> f32 {
-        let w = (self.bbox[2].min(other.bbox[2]) - self.bbox[0].max(other.bbox[0])).max(0.0);
-        let h = (self.bbox[3].min(other.bbox[3]) - self.bbox[1].max(other.bbox[1])).max(0.0);
-        let inter = w * h;
-        let union = self.area() + other.area() - inter;
-        if union > 0.0 { inter / union } else { 0.0 }
+        box_iou(&self.bbox, &other.bbox)
     }
+}
+
+/// Intersection over union of two boxes (xmin, ymin, xmax, ymax).
+pub fn box_iou(a: &[f32; 4], b: &[f32; 4]) -> f32 {
+    let w = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
+    let h = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
+    let inter = w * h;
+    let union = box_area(a) + box_area(b) - inter;
+    if union > 0.0 { inter / union } else { 0.0 }
+}
+
+fn box_area(r: &[f32; 4]) -> f32 {
+    (r[2] - r[0]).max(0.0) * (r[3] - r[1]).max(0.0)
 }
 
 /// The letterbox the detector sees: the whole image, padded to a square with black.
