@@ -30,6 +30,7 @@ use std::time::{Duration, Instant};
 
 use burn::tensor::Device;
 use mannequin_avatar::evaluation::evaluate_avatar;
+use mannequin_avatar::test_pose_fit::TestPoseMode;
 use mannequin_avatar::{
     Avatar, AvatarConfig, Canonical, HALF_RESOLUTION_SHARE, Method, SkirtMode, Timings, TrainOptions,
     Trainer, View, load_views,
@@ -107,7 +108,7 @@ fn run(
     let model_dir = dir.join(name.replace("w/o ", "without-"));
     trainer.avatar.save(&model_dir).expect("save");
     let options = EvalOptions { background: [1.0; 3], lpips: None, samples: 100_000, seed: 0 };
-    let scores = evaluate_avatar(&model_dir, data, &options, &|_, _| {}, &|| {}).expect("evaluate");
+    let scores = evaluate_avatar(&model_dir, data, &options, TestPoseMode::Auto, &|_, _, _| {}, &|| {}).expect("evaluate");
     (scores, per_iter)
 }
 

@@ -37,6 +37,7 @@ pub mod settings;
 pub mod sh_colour;
 pub mod skirt_layer;
 pub mod subject_mesh;
+pub mod test_pose_fit;
 pub mod trainer;
 pub mod training;
 pub mod view_loss;

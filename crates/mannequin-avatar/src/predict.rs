@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mannequin_data::{Dataset, DatasetWriter, DepthMap, Frame, Image, Mask, NormalMap};
+use mannequin_data::{Dataset, DatasetWriter, DepthMap, Frame, Image, Mask, NormalMap, Split};
 use mannequin_mesh::TriMesh;
 
 use crate::avatar::Avatar;
@@ -62,16 +62,15 @@ pub fn predict(
     })
 }
 
-/// Renders every frame of `split` of `dataset` into `out` (images, masks, normals, depth,
-/// meshes, in the dataset layout), calling `on_frame` after each.
+/// Renders every frame of `split` of `dataset` at the split's poses into `out` (images, masks,
+/// normals, depth, meshes, in the dataset layout), calling `on_frame` after each.
 pub fn predict_split(
     avatar: &Avatar,
     dataset: &Dataset,
-    split: &str,
+    split: &Split,
     out: &Path,
     on_frame: &dyn Fn(),
 ) -> Result<(), AvatarError> {
-    let split = dataset.split(split)?;
     let writer = DatasetWriter::new(out);
     let garments: Vec<_> = avatar
         .canonical

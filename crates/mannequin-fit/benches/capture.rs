@@ -18,28 +18,13 @@ use mannequin_body::BodyModel;
 use mannequin_data::{Camera, Dataset, Poses};
 use mannequin_fit::body_fit::{Fitter, assumed_focal};
 use mannequin_fit::clip_fit::{Tracker, fit_clip, resolve_mirrors};
-use mannequin_fit::rigid_alignment::best_rotation;
+use mannequin_fit::pose_error::aligned_error;
 use mannequin_fit::{PersonModels, fit_body};
 use mannequin_synth::{SynthOptions, generate};
 
 #[path = "../../../tools/bench_args.rs"]
 mod bench_args;
 use bench_args::arg;
-
-/// Mean distance between `a` and `b` once `a` is moved onto `b` by the best similarity.
-fn aligned_error(a: &[DVec3], b: &[DVec3]) -> f64 {
-    let w = vec![1.0; a.len()];
-    let r = best_rotation(a, b, &w).expect("a body fixes a rotation");
-    let (ma, mb) = (mean(a), mean(b));
-    let num: f64 = a.iter().zip(b).map(|(p, q)| (r * (*p - ma)).dot(*q - mb)).sum();
-    let den: f64 = a.iter().map(|p| (*p - ma).length_squared()).sum();
-    let s = num / den;
-    a.iter().zip(b).map(|(p, q)| (s * (r * (*p - ma)) + mb - *q).length()).sum::<f64>() / a.len() as f64
-}
-
-fn mean(p: &[DVec3]) -> DVec3 {
-    p.iter().copied().sum::<DVec3>() / p.len() as f64
-}
 
 /// Joints and vertices of a body in a camera's space.
 fn in_camera(
@@ -104,7 +89,8 @@ fn main() {
             let (tj, tv) =
                 in_camera(&model, &truth.betas, &truth.pose72(i), &truth.transl[i], dataset.camera(i));
             let (fj, fv) = in_camera(&model, &fit.betas, &fit.pose, &fit.transl, &fit.camera);
-            let (e_j, e_v) = (aligned_error(&fj, &tj), aligned_error(&fv, &tv));
+            let aligned = |a: &[DVec3], b: &[DVec3]| aligned_error(a, b).expect("a body fixes a rotation");
+            let (e_j, e_v) = (aligned(&fj, &tj), aligned(&fv, &tv));
             if std::env::args().any(|a| a == "--per-frame") {
                 println!("  frame {i:3}: PA-MPJPE {:.1} mm, per-vertex {:.1} mm", 1000.0 * e_j, 1000.0 * e_v);
             }

@@ -34,6 +34,7 @@ pub mod output;
 pub mod overlay;
 pub mod person_models;
 pub mod person_search;
+pub mod pose_error;
 pub mod pose_landmarker;
 pub mod pose_prior;
 pub mod rigid_alignment;

@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use mannequin_avatar::evaluation::evaluate_avatar;
+use mannequin_avatar::test_pose_fit::TestPoseMode;
 use mannequin_data::evaluation::{EvalOptions, MAX_SURFACE_SAMPLES, evaluate, test_frames};
 use mannequin_data::metrics::lpips::Lpips;
-use mannequin_data::{Scores, TestSet};
+use mannequin_data::{Scores, TestPoses, TestSet};
 
 use mannequin_io::progress::{JobTimer, bar};
 
@@ -34,6 +35,11 @@ pub struct Args {
     /// What --gt's test frames are, which names them in the scores.
     #[arg(long, value_enum, default_value_t = TestSet::Test, requires = "pred")]
     set: TestSet,
+    /// Poses of --avatar's test frames: auto fits each to its image first (the avatar frozen) where
+    /// --data's poses were estimated (`mannequin capture`), and takes them as they are where they
+    /// are the truth; as-is and fit choose.
+    #[arg(long, value_enum, default_value_t = TestPoseMode::Auto, requires = "avatar")]
+    test_poses: TestPoseMode,
     /// Write the scores (means and per frame) to this JSON file.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -74,10 +80,13 @@ fn evaluate_with_progress(
     avatar: &std::path::Path,
     data: &std::path::Path,
     options: &EvalOptions,
+    test_poses: TestPoseMode,
 ) -> Result<Scores> {
     let current: RefCell<Option<ProgressBar>> = RefCell::new(None);
-    let on_set = |set: TestSet, frames: usize| {
-        if let Some(b) = current.replace(Some(bar(2 * frames as u64, set.name()))) {
+    let on_set = |set: TestSet, frames: usize, poses: TestPoses| {
+        tracing::info!("{}: {poses}", set.name());
+        let stages = if matches!(poses, TestPoses::Fit { .. }) { 3 } else { 2 };
+        if let Some(b) = current.replace(Some(bar((stages * frames) as u64, set.name()))) {
             b.finish_and_clear();
         }
     };
@@ -86,7 +95,7 @@ fn evaluate_with_progress(
             b.inc(1);
         }
     };
-    let scores = evaluate_avatar(avatar, data, options, &on_set, &on_frame)?;
+    let scores = evaluate_avatar(avatar, data, options, test_poses, &on_set, &on_frame)?;
     if let Some(b) = current.take() {
         b.finish_and_clear();
     }
@@ -99,15 +108,16 @@ fn cell(v: Option<f64>, digits: usize) -> String {
 
 /// The scores as a table on stdout: a row per test set, then the geometry.
 fn print_scores(s: &Scores) {
-    println!("{:>11} {:>7} {:>8} {:>7} {:>7}", "test set", "frames", "PSNR", "SSIM", "LPIPS");
+    println!("{:>11} {:>7} {:>8} {:>7} {:>7}  poses", "test set", "frames", "PSNR", "SSIM", "LPIPS");
     for (set, summary) in s.sets() {
         println!(
-            "{:>11} {:>7} {:>8.2} {:>7.4} {:>7}",
+            "{:>11} {:>7} {:>8.2} {:>7.4} {:>7}  {}",
             set.name(),
             summary.frames,
             summary.psnr,
             summary.ssim,
-            cell(summary.lpips, 4)
+            cell(summary.lpips, 4),
+            summary.test_poses
         );
     }
     let g = &s.geometry;
@@ -133,7 +143,7 @@ pub fn run(args: Args) -> Result<()> {
     let lpips = args.lpips_weights.as_deref().map(Lpips::load).transpose()?;
     let options = EvalOptions { background, lpips, samples: args.samples as usize, seed: args.seed };
     let scores = match (&args.avatar, &args.data, &args.pred, &args.gt) {
-        (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, &options)?,
+        (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, &options, args.test_poses)?,
         (_, _, Some(pred), Some(gt)) => {
             let frames = test_frames(gt)?;
             let progress = bar(frames.len() as u64, args.set.name());
