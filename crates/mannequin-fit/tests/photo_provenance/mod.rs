@@ -7,6 +7,33 @@ use std::path::{Path, PathBuf};
 /// The file beside the photos that lists them.
 pub const PROVENANCE: &str = "PROVENANCE.md";
 
+/// Where one person's head is, in the photo's pixels, marked by eye.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Head {
+    pub x: [f32; 2],
+    pub y: [f32; 2],
+}
+
+impl Head {
+    /// Whether the point lies on this head, the box grown by a quarter of its size each way
+    /// (boxes marked by eye, a nose near a chin or an ear).
+    pub fn holds(&self, point: [f32; 2]) -> bool {
+        let near = |[lo, hi]: [f32; 2], v: f32| (lo - 0.25 * (hi - lo)..=hi + 0.25 * (hi - lo)).contains(&v);
+        near(self.x, point[0]) && near(self.y, point[1])
+    }
+
+    /// "x A–B, y C–D", as `PROVENANCE.md` writes a head.
+    fn parse(text: &str) -> Option<Self> {
+        let range = |t: &str| -> Option<[f32; 2]> {
+            let (lo, hi) = t.split_once('–')?;
+            let (lo, hi) = (lo.trim().parse().ok()?, hi.trim().parse().ok()?);
+            (lo < hi).then_some([lo, hi])
+        };
+        let (x, y) = text.trim().split_once(", ")?;
+        Some(Self { x: range(x.strip_prefix("x ")?)?, y: range(y.strip_prefix("y ")?)? })
+    }
+}
+
 /// What `PROVENANCE.md` says of one photo.
 #[derive(Debug, Default)]
 pub struct PhotoEntry {
@@ -14,8 +41,9 @@ pub struct PhotoEntry {
     pub name: String,
     /// The text after "- Licence: ".
     pub licence: Option<String>,
-    /// How many people a person sees in it, after "- People: ".
-    pub people: Option<usize>,
+    /// Every person's head, after "- Heads: " ("x A–B, y C–D" joined by "; "); None when the
+    /// line is missing or any box in it does not read.
+    pub heads: Option<Vec<Head>>,
     /// Made from another photo here (marked **Derived**), not a distinct original.
     pub derived: bool,
 }
@@ -56,8 +84,8 @@ pub fn entries(text: &str) -> Vec<PhotoEntry> {
         let Some(entry) = out.last_mut().filter(|_| in_section) else { continue };
         if let Some(licence) = line.strip_prefix("- Licence: ") {
             entry.licence = Some(licence.trim().to_string());
-        } else if let Some(people) = line.strip_prefix("- People: ") {
-            entry.people = people.trim().parse().ok();
+        } else if let Some(heads) = line.strip_prefix("- Heads: ") {
+            entry.heads = heads.split(';').map(Head::parse).collect();
         } else if line.starts_with("**Derived**") {
             entry.derived = true;
         }
