@@ -25,7 +25,8 @@ fn test_sets(data: &Path) -> Vec<(TestSet, PathBuf)> {
     if nested.is_empty() { vec![(TestSet::Test, data.to_path_buf())] } else { nested }
 }
 
-/// Renders and scores every test set, at poses `test_poses` chooses per set. Predictions are written under temporary names in `MODEL`
+/// Renders and scores every test set, at poses `test_poses` chooses per set, against the set's
+/// own frames or the same frames of `truth` (see `mannequin eval --truth`). Predictions are written under temporary names in `MODEL`
 /// and replace an earlier run's `MODEL/eval/<set>/` only once every set is scored, so a failed
 /// evaluation leaves the model folder as it was.
 /// `on_set(set, frames, poses)` is called before each set, `on_frame` after each pose fit, each
@@ -33,6 +34,7 @@ fn test_sets(data: &Path) -> Vec<(TestSet, PathBuf)> {
 pub fn evaluate_avatar(
     model: &Path,
     data: &Path,
+    truth: Option<&Path>,
     options: &EvalOptions,
     test_poses: TestPoseMode,
     on_set: &dyn Fn(TestSet, usize, TestPoses),
@@ -60,7 +62,7 @@ pub fn evaluate_avatar(
             split.poses = fit_test_poses(fitter, &dataset, &split, steps, on_frame)?;
         }
         predict_split(&avatar, &dataset, &split, stage.path(), on_frame)?;
-        let mut summary = evaluate(stage.path(), &dir, &frames, options, &|_| on_frame())?;
+        let mut summary = evaluate(stage.path(), truth.unwrap_or(&dir), &frames, options, &|_| on_frame())?;
         summary.pred = out;
         summary.test_poses = poses;
         summaries.push((set, summary));

@@ -15,9 +15,9 @@ use crate::params::{Param, host, tensor_from};
 use crate::views::View;
 
 /// Learning rate of the axis-angle pose (radians per step at most, Adam's scale).
-pub const POSE_LR: f64 = 2e-3;
+pub const POSE_LR: f64 = 1.5e-2;
 /// Learning rate of the root translation (metres per step at most).
-pub const TRANSL_LR: f64 = 5e-4;
+pub const TRANSL_LR: f64 = 3e-3;
 /// Share of the iterations, from the start, before the poses move: the avatar must first look
 /// like the person, or the photometric gradient pulls the poses towards a blur.
 pub const START_SHARE: f64 = 0.1;

@@ -33,6 +33,9 @@ pub struct EvalOptions {
     pub lpips: Option<Lpips>,
     /// Surface samples per mesh for the geometry metrics.
     pub samples: usize,
+    /// Whether meshes both folders hold are compared: not where the prediction lives in another
+    /// world frame than the truth (an avatar trained on `capture`'s poses and camera).
+    pub compare_meshes: bool,
     pub seed: u64,
 }
 
@@ -233,7 +236,7 @@ fn score_frame(
         None
     };
     let mesh_metrics = |pm_path: PathBuf, gm_path: PathBuf| -> Result<Option<GeometryMetrics>, DataError> {
-        if !(pm_path.exists() && gm_path.exists()) {
+        if !(opt.compare_meshes && pm_path.exists() && gm_path.exists()) {
             return Ok(None);
         }
         let pm = surface(&pm_path)?;

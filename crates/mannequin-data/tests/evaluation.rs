@@ -74,7 +74,7 @@ fn perfect_prediction(i: usize, size: usize) -> Frame {
 }
 
 fn options() -> EvalOptions {
-    EvalOptions { background: BG, lpips: None, samples: 5000, seed: 1 }
+    EvalOptions { background: BG, lpips: None, samples: 5000, seed: 1, compare_meshes: true }
 }
 
 #[test]

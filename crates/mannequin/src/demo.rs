@@ -1,7 +1,8 @@
-//! `mannequin demo`: the README's main job on the embedded default body. It makes a synthetic
-//! clothed subject, trains a Tavatar avatar on it, evaluates it on novel views and poses,
-//! animates it with a walk, and exports it (skinned .glb, 3DGS .ply, posed .obj), all under one
-//! folder. Each stage runs the same code as its own verb (through the command line the binary
+//! `mannequin demo`: the README's main job on the embedded default body, on the user's path. It
+//! makes a synthetic clothed subject and hands its frames to `capture` as plain images (no
+//! poses, masks or camera), trains a Tavatar avatar on what `capture` recovers (refining the
+//! poses), scores the held-out frames against the subject's truth, animates the avatar with a
+//! walk, and exports it (skinned .glb, 3DGS .ply, posed .obj), all under one folder. Each stage runs the same code as its own verb (through the command line the binary
 //! hands in); one progress bar at a time shows the stage it belongs to.
 
 use std::path::PathBuf;
@@ -27,6 +28,10 @@ pub struct Args {
     /// Image size of the synthetic subject.
     #[arg(long, default_value_t = SynthOptions::default().size)]
     size: usize,
+    /// Frames of the synthetic subject's turning capture that go to `capture` (the last tenth are
+    /// held out and scored).
+    #[arg(long, default_value_t = SynthOptions::default().capture_frames as u64, value_parser = clap::value_parser!(u64).range(10..))]
+    frames: u64,
     /// Frames of the walk animation.
     #[arg(long, default_value_t = 60)]
     walk_frames: usize,
@@ -38,17 +43,37 @@ pub fn run(args: Args, run_verb: impl Fn(&[&str]) -> Result<()>) -> Result<()> {
     let path = |p: &str| args.out.join(p).to_string_lossy().into_owned();
     let (seed, iters, size, frames) =
         (args.seed.to_string(), args.iters.to_string(), args.size.to_string(), args.walk_frames.to_string());
-    let (subject, avatar, walk) = (path("subject"), path("avatar"), path("walk.npz"));
+    // Synth's own split is not used (capture makes one); it needs one training frame fewer.
+    let (capture_frames, synth_train) = (args.frames.to_string(), (args.frames - 1).to_string());
+    let (subject, captured, avatar, walk) =
+        (path("subject"), path("captured"), path("avatar"), path("walk.npz"));
+    let images = path("subject/images");
     let (eval_json, walk_dir) = (path("eval.json"), path("walk"));
     let (glb, splats, squat) = (path("avatar.glb"), path("avatar_gaussians.ply"), path("avatar_squat.obj"));
     let stages: Vec<(&str, Vec<&str>)> = vec![
-        ("subject", vec!["synth", "--seed", &seed, "--size", &size, "--out", &subject]),
+        (
+            "subject",
+            vec![
+                "synth",
+                "--seed",
+                &seed,
+                "--size",
+                &size,
+                "--frames",
+                &capture_frames,
+                "--train",
+                &synth_train,
+                "--out",
+                &subject,
+            ],
+        ),
+        ("capture", vec!["capture", "--frames", &images, "--out", &captured, "--restart"]),
         (
             "train",
             vec![
                 "train",
                 "--data",
-                &subject,
+                &captured,
                 "--out",
                 &avatar,
                 "--iters",
@@ -58,7 +83,10 @@ pub fn run(args: Args, run_verb: impl Fn(&[&str]) -> Result<()>) -> Result<()> {
                 "--restart",
             ],
         ),
-        ("evaluate", vec!["eval", "--avatar", &avatar, "--data", &subject, "--json", &eval_json]),
+        (
+            "evaluate",
+            vec!["eval", "--avatar", &avatar, "--data", &captured, "--truth", &subject, "--json", &eval_json],
+        ),
         ("motion", vec!["motion", "walk", "-o", &walk]),
         (
             "animate",

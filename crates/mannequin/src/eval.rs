@@ -35,6 +35,11 @@ pub struct Args {
     /// What --gt's test frames are, which names them in the scores.
     #[arg(long, value_enum, default_value_t = TestSet::Test, requires = "pred")]
     set: TestSet,
+    /// Score --avatar's renders of --data's test frames against this dataset's images, masks and
+    /// normal maps of the same frames: the synthetic subject whose frames went to `mannequin
+    /// capture` as plain images. Meshes are left out: the avatar lives in --data's world frame.
+    #[arg(long, requires = "avatar")]
+    truth: Option<PathBuf>,
     /// Poses of --avatar's test frames: auto fits each to its image first (the avatar frozen) where
     /// --data's poses were estimated (`mannequin capture`), and takes them as they are where they
     /// are the truth; as-is and fit choose.
@@ -79,6 +84,7 @@ fn parse_background(s: &str) -> Result<[f32; 3]> {
 fn evaluate_with_progress(
     avatar: &std::path::Path,
     data: &std::path::Path,
+    truth: Option<&std::path::Path>,
     options: &EvalOptions,
     test_poses: TestPoseMode,
 ) -> Result<Scores> {
@@ -95,7 +101,7 @@ fn evaluate_with_progress(
             b.inc(1);
         }
     };
-    let scores = evaluate_avatar(avatar, data, options, test_poses, &on_set, &on_frame)?;
+    let scores = evaluate_avatar(avatar, data, truth, options, test_poses, &on_set, &on_frame)?;
     if let Some(b) = current.take() {
         b.finish_and_clear();
     }
@@ -141,9 +147,15 @@ pub fn run(args: Args) -> Result<()> {
     let _timer = JobTimer::start("eval");
     let background = parse_background(&args.background)?;
     let lpips = args.lpips_weights.as_deref().map(Lpips::load).transpose()?;
-    let options = EvalOptions { background, lpips, samples: args.samples as usize, seed: args.seed };
+    let options = EvalOptions {
+        background,
+        lpips,
+        samples: args.samples as usize,
+        seed: args.seed,
+        compare_meshes: args.truth.is_none(),
+    };
     let scores = match (&args.avatar, &args.data, &args.pred, &args.gt) {
-        (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, &options, args.test_poses)?,
+        (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, args.truth.as_deref(), &options, args.test_poses)?,
         (_, _, Some(pred), Some(gt)) => {
             let frames = test_frames(gt)?;
             let progress = bar(frames.len() as u64, args.set.name());
