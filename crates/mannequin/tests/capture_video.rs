@@ -180,3 +180,59 @@ fn a_person_index_out_of_range_is_refused_naming_the_frame_and_how_many_were_fou
     );
     assert!(!out.exists(), "nothing is written");
 }
+
+/// Frames with two people side by side on a 256 × 128 canvas: the subject's frame i on the
+/// left and its frame i + 4 on the right.
+fn two_people(frames: &Path, count: usize) {
+    std::fs::create_dir_all(frames).unwrap();
+    for i in 0..count {
+        let read = |k: usize| Image::read(&subject().join(format!("images/image_{k:04}.png"))).unwrap();
+        let (left, right) = (read(i), read(i + 4));
+        let pixels = (0..256 * 128)
+            .map(|p| {
+                let (x, y) = (p % 256, p / 256);
+                if x < 128 { left.at(x, y) } else { right.at(x - 128, y) }
+            })
+            .collect();
+        Image { width: 256, height: 128, pixels }.write_png(&frames.join(format!("{i}.png"))).unwrap();
+    }
+}
+
+/// Whether a mask lies on the canvas's left half (ten times more of it there than on the right),
+/// its right half, or neither (None).
+fn side(mask: &mannequin_data::Mask) -> Option<bool> {
+    let left =
+        (0..mask.height).flat_map(|y| (0..128).map(move |x| (x, y))).filter(|&(x, y)| mask.at(x, y)).count();
+    let right = mask.count() - left;
+    println!("mask: {left} px on the left, {right} on the right");
+    match (left > 10 * right.max(1), right > 10 * left.max(1)) {
+        (true, _) => Some(true),
+        (_, true) => Some(false),
+        _ => None,
+    }
+}
+
+#[test]
+fn the_person_asked_for_is_followed_through_the_clip() {
+    let dir = scratch("capture_two");
+    let frames = dir.join("frames");
+    two_people(&frames, 4);
+    let mut sides = Vec::new();
+    for person in ["0", "1"] {
+        let out = dir.join(format!("person_{person}"));
+        ok(mannequin(&["capture", "--frames", s(&frames), "--person", person, "--out", s(&out)]));
+        let dataset = mannequin_data::Dataset::open(&out, 1).unwrap();
+        assert_eq!(dataset.frame_count, 4, "--person {person}: the person is in every frame");
+        let first = side(&dataset.frame(0).unwrap().mask);
+        assert!(first.is_some(), "--person {person}: frame 0's mask covers both people");
+        for i in 1..4 {
+            assert_eq!(
+                side(&dataset.frame(i).unwrap().mask),
+                first,
+                "--person {person}, frame {i}: another person"
+            );
+        }
+        sides.push(first);
+    }
+    assert_ne!(sides[0], sides[1], "--person 0 and --person 1 follow different people");
+}
