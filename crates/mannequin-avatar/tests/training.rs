@@ -113,6 +113,58 @@ fn resume_matches() {
 }
 
 #[test]
+fn a_run_refining_its_poses_resumes_bit_for_bit_and_saves_them() {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    pool.install(|| {
+        let data = subject("refine");
+        let options = TrainOptions { refine_poses: true, ..TrainOptions::new(Method::Tavatar, 6, 7) };
+        let betas = Dataset::open(&data, 1).unwrap().split("train").unwrap().poses.betas;
+        let mut straight = trainer_with(&data, Method::Tavatar, options.clone());
+        for _ in 0..6 {
+            straight.step().unwrap();
+        }
+        let mut first = trainer_with(&data, Method::Tavatar, options.clone());
+        for _ in 0..3 {
+            first.step().unwrap();
+        }
+        let checkpoint = data.join("refine.npz");
+        first.save_checkpoint(&checkpoint, &record(&first, &data)).unwrap();
+        let mut resumed = trainer_with(&data, Method::Tavatar, options.clone());
+        let run = record(&resumed, &data);
+        resumed.resume(&Checkpoint::open(&checkpoint, &run, &[]).unwrap(), &run).unwrap();
+        for _ in 0..3 {
+            resumed.step().unwrap();
+        }
+        assert!(parameters(&straight) == parameters(&resumed), "the avatar differs after resuming");
+        let (a, b) = (straight.refined_poses(&betas).unwrap(), resumed.refined_poses(&betas).unwrap());
+        assert!(a == b, "the refined poses differ after resuming");
+        let initial = Dataset::open(&data, 1).unwrap().split("train").unwrap().poses;
+        assert!(a != initial, "no pose was refined");
+        // A run without refinement records none, and so refuses this checkpoint.
+        let plain = trainer_with(&data, Method::Tavatar, TrainOptions::new(Method::Tavatar, 6, 7));
+        let e = Checkpoint::open(&checkpoint, &record(&plain, &data), &[]).err().unwrap().to_string();
+        assert!(e.contains("options.refine_poses"), "{e}");
+        // The run saves them beside the avatar, in the pose format.
+        let out = data.join("model");
+        let run = record(&resumed, &data);
+        Training {
+            trainer: resumed,
+            record: run,
+            checkpoint_every: 100,
+            out: out.clone(),
+            betas: betas.clone(),
+        }
+        .run()
+        .unwrap();
+        let saved =
+            mannequin_data::Poses::read(&out.join(mannequin_avatar::training::REFINED_POSES)).unwrap();
+        assert_eq!(saved.len(), b.len());
+        assert_eq!(saved.betas, betas);
+        std::fs::remove_dir_all(data).ok();
+    });
+}
+
+#[test]
 fn loss_falls_and_a_nan_stops_the_run_naming_the_iteration() {
     let data = subject("loss");
     // Constant rates: over 40 iterations the default decay would make the later steps tiny.
@@ -140,7 +192,9 @@ fn a_run_trains_to_its_iterations_and_saves_the_avatar() {
     let out = data.join("model");
     let trainer = trainer(&data, Method::Tavatar, 3);
     let run = record(&trainer, &data);
-    Training { trainer, record: run.clone(), checkpoint_every: 2, out: out.clone(), betas: Vec::new() }.run().unwrap();
+    Training { trainer, record: run.clone(), checkpoint_every: 2, out: out.clone(), betas: Vec::new() }
+        .run()
+        .unwrap();
     assert_eq!(Checkpoint::open(&checkpoint_path(&out), &run, &[]).unwrap().iteration, 3);
     assert!(Avatar::load(&out, &Device::flex()).is_ok(), "no avatar in {}", out.display());
     std::fs::remove_dir_all(data).ok();
