@@ -15,11 +15,10 @@ use glam::{DQuat, DVec3};
 use mannequin_body::rodrigues::{axis_angle_quat, quat_axis_angle};
 use mannequin_data::Image;
 
-use crate::blazepose::LANDMARKS;
 use crate::body_fit::{Anchor, BodyFit, Fitter, FramePose, rotation_gap};
 use crate::crop::RotatedRect;
 use crate::error::FitError;
-use crate::person_models::{Person, PersonModels, pick_person};
+use crate::person_models::{Person, PersonModels, body_box, pick_person};
 use crate::pose_landmarker::PoseLandmarks;
 use crate::ssd_detector::box_iou;
 
@@ -175,15 +174,6 @@ impl<'a> Tracker<'a> {
             },
         })
     }
-}
-
-/// The box a person's body landmarks span, in image pixels.
-fn body_box(l: &PoseLandmarks) -> [f32; 4] {
-    l.points[..LANDMARKS.len()]
-        .iter()
-        .fold([f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY], |[x0, y0, x1, y1], p| {
-            [x0.min(p[0]), y0.min(p[1]), x1.max(p[0]), y1.max(p[1])]
-        })
 }
 
 /// How far a clip's fit has got: the passes done, the clip's shape and each frame's pose and

@@ -4,13 +4,14 @@
 
 use mannequin_data::Image;
 
+use crate::blazepose::LANDMARKS;
 use crate::crop::{Border, RotatedRect, crop, uncrop};
 use crate::error::FitError;
 use crate::face_models::FACE_DETECTION;
 use crate::network::Network;
 use crate::person_search::{body_seeds, windows};
 use crate::pose_landmarker::{MIN_POSE_FLAG, PoseLandmarks, aligned_roi, detection_roi, estimate};
-use crate::ssd_detector::{Detection, FACE, POSE, letterbox, suppress};
+use crate::ssd_detector::{Detection, FACE, POSE, box_iou, letterbox, suppress};
 
 const POSE_DETECTION: &[u8] = include_bytes!("../models/pose_detection.onnx");
 const POSE_LANDMARK: &[u8] = include_bytes!("../models/pose_landmark_full.onnx");
@@ -18,9 +19,12 @@ const SELFIE_SEGMENTATION: &[u8] = include_bytes!("../models/selfie_segmentation
 const SELFIE_SIZE: usize = 256;
 /// Two people whose boxes are this close in area are too alike to pick between.
 const SAME_SIZE: f32 = 0.85;
-/// Two readings whose body crops' centres are closer than this fraction of the crop's side are
-/// of one person.
-const SAME_PLACE: f32 = 0.25;
+/// Two readings whose bodies' boxes overlap by more than this IoU are of one person.
+const SAME_BODY: f32 = 0.5;
+/// The landmarker's confidence a person found by searching (windows, faces) needs: many more
+/// crops are read than in the whole picture, so more that hold no one pass MediaPipe's own
+/// [`MIN_POSE_FLAG`] (a chest pack, a horse's head).
+const MIN_SEARCHED_FLAG: f32 = 0.9;
 
 /// The three networks, ready to run.
 pub struct PersonModels {
@@ -67,24 +71,24 @@ impl PersonModels {
     /// Everyone the detector finds in the whole picture (letterboxed) whose landmark crop the
     /// landmarker confirms, largest box first: what MediaPipe's own pipeline finds.
     pub fn in_whole_picture(&self, image: &Image) -> Result<Vec<Person>, FitError> {
-        self.confirmed(image, POSE.detect(&self.detector, image)?)
+        self.confirmed(image, POSE.detect(&self.detector, image)?, MIN_POSE_FLAG)
     }
 
     /// Everyone the detector finds in the overlapping square windows of [`windows`] (two or
     /// three scales), the windows' detections merged where they overlap, each confirmed by the
-    /// landmarker.
+    /// landmarker at [`MIN_SEARCHED_FLAG`], each person once.
     pub fn in_windows(&self, image: &Image) -> Result<Vec<Person>, FitError> {
         let mut candidates = Vec::new();
         for window in windows(image.width, image.height) {
             candidates.extend(POSE.detect_in(&self.detector, image, &window)?);
         }
-        Ok(distinct(self.confirmed(image, suppress(candidates))?))
+        Ok(distinct(self.confirmed(image, suppress(candidates), MIN_SEARCHED_FLAG)?))
     }
 
     /// The bodies below the faces BlazeFace finds in the whole picture and in the windows of
     /// [`windows`]: for each face, the landmarks read in the body regions [`body_seeds`]
-    /// proposes, the surest kept where the landmarker confirms it. The person's box is the face's,
-    /// as the pose detector's own box is.
+    /// proposes, the surest kept where the landmarker confirms it at [`MIN_SEARCHED_FLAG`] with
+    /// the body's nose on the face, each person once. The person's box is the face's, as the pose detector's own box is.
     pub fn below_faces(&self, image: &Image) -> Result<Vec<Person>, FitError> {
         let mut faces = FACE.detect(&self.face_detector, image)?;
         for window in windows(image.width, image.height) {
@@ -95,7 +99,8 @@ impl PersonModels {
             let mut best: Option<Person> = None;
             for [hip, scale] in body_seeds(&face) {
                 let landmarks = estimate(&self.landmarker, image, aligned_roi(hip, scale))?;
-                if landmarks.flag >= MIN_POSE_FLAG
+                if landmarks.flag >= MIN_SEARCHED_FLAG
+                    && nose_on_face(&landmarks, &face)
                     && best.as_ref().is_none_or(|b| landmarks.flag > b.landmarks.flag)
                 {
                     let detection = Detection { keypoints: vec![hip, scale], ..face.clone() };
@@ -104,16 +109,21 @@ impl PersonModels {
             }
             out.extend(best);
         }
-        out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
-        Ok(out)
+        Ok(distinct(out))
     }
 
-    /// The detections whose landmark crop the landmarker confirms, largest box first.
-    fn confirmed(&self, image: &Image, detections: Vec<Detection>) -> Result<Vec<Person>, FitError> {
+    /// The detections whose landmark crop the landmarker confirms (its flag at least `min_flag`),
+    /// largest box first.
+    fn confirmed(
+        &self,
+        image: &Image,
+        detections: Vec<Detection>,
+        min_flag: f32,
+    ) -> Result<Vec<Person>, FitError> {
         let mut out = Vec::new();
         for detection in detections {
             let landmarks = estimate(&self.landmarker, image, detection_roi(&detection))?;
-            if landmarks.flag >= MIN_POSE_FLAG {
+            if landmarks.flag >= min_flag {
                 out.push(Person { detection, landmarks });
             }
         }
@@ -148,23 +158,34 @@ impl PersonModels {
 
 /// `people` less those read twice: windows of two scales can give the same person two detection
 /// boxes too unlike to merge (one the face, one the head), but the landmarks read from both put
-/// the body in the same place ([`PoseLandmarks::next_roi`], the crop the whole body sets). The
-/// surer reading is kept; largest box first.
+/// the body in the same place. The surer reading is kept; largest box first.
 fn distinct(mut people: Vec<Person>) -> Vec<Person> {
     people.sort_by(|a, b| b.landmarks.flag.total_cmp(&a.landmarks.flag));
     let mut out: Vec<Person> = Vec::new();
     for person in people {
-        let r = person.landmarks.next_roi;
-        let same = |o: &Person| {
-            let q = o.landmarks.next_roi;
-            (r.cx - q.cx).hypot(r.cy - q.cy) < SAME_PLACE * r.width.min(q.width)
-        };
-        if !out.iter().any(same) {
+        let body = body_box(&person.landmarks);
+        if !out.iter().any(|o| box_iou(&body_box(&o.landmarks), &body) > SAME_BODY) {
             out.push(person);
         }
     }
     out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
     out
+}
+
+/// Whether the body read below a face is that face's: its nose (landmark 0) on the face's box.
+fn nose_on_face(landmarks: &PoseLandmarks, face: &Detection) -> bool {
+    let [x, y, _] = landmarks.points[0];
+    let [x0, y0, x1, y1] = face.bbox;
+    (x0..=x1).contains(&x) && (y0..=y1).contains(&y)
+}
+
+/// The box a person's body landmarks span, in image pixels.
+pub fn body_box(l: &PoseLandmarks) -> [f32; 4] {
+    l.points[..LANDMARKS.len()]
+        .iter()
+        .fold([f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY], |[x0, y0, x1, y1], p| {
+            [x0.min(p[0]), y0.min(p[1]), x1.max(p[0]), y1.max(p[1])]
+        })
 }
 
 /// The person `wanted` names (counting from 0, largest first), else the only or clearly largest
