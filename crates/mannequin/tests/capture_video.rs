@@ -236,3 +236,25 @@ fn the_person_asked_for_is_followed_through_the_clip() {
     }
     assert_ne!(sides[0], sides[1], "--person 0 and --person 1 follow different people");
 }
+
+#[test]
+fn a_resumed_capture_following_another_person_is_refused() {
+    let dir = scratch("capture_resume");
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    for i in 0..2 {
+        std::fs::copy(subject().join(format!("images/image_{i:04}.png")), frames.join(format!("{i}.png")))
+            .unwrap();
+    }
+    let out = dir.join("out");
+    // A focal length far off the frames' size is refused only once they are tracked and
+    // checkpointed: a stopped capture with a checkpoint to resume from.
+    let stopped = mannequin(&["capture", "--frames", s(&frames), "--focal", "1", "--out", s(&out)]);
+    one_line_error(&stopped, &["--focal"]);
+    assert!(out.join("checkpoint.npz").exists(), "the tracked frames are checkpointed");
+    one_line_error(
+        &mannequin(&["capture", "--frames", s(&frames), "--focal", "1", "--person", "0", "--out", s(&out)]),
+        &["checkpoint.npz", "person was null, now 0"],
+    );
+    assert!(out.join("checkpoint.npz").exists(), "the refused checkpoint is kept");
+}
