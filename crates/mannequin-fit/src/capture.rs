@@ -217,8 +217,9 @@ fn track(
         return Err(FitError::input(
             first_lost.display().to_string(),
             format!(
-                "the first of {} frames without the person (found in {} of {}, a capture needs them in at least {needed}); \
-                 cut the clip to where they are, or choose who to follow with --person N",
+                "the first of {} frames without the person (found in {} of {}, a capture needs them \
+                 in at least {needed}); cut the clip to where they are, or choose who to follow with \
+                 --person N",
                 saved.skipped.len(),
                 saved.kept.len(),
                 files.len()

@@ -1,6 +1,6 @@
 //! The shipped person models, loaded once: MediaPipe's pose detector, pose landmarker and
-//! selfie segmenter, and BlazeFace to find a body from its face (Apache-2.0, converted to ONNX by `tools/person_models`; see
-//! `models/NOTICE.md`).
+//! selfie segmenter, and BlazeFace to find a body from its face (Apache-2.0, converted to ONNX
+//! by `tools/person_models`; see `models/NOTICE.md`).
 
 use mannequin_data::Image;
 
@@ -26,7 +26,7 @@ const SAME_BODY: f32 = 0.5;
 /// [`MIN_POSE_FLAG`] (a chest pack, a horse's head).
 const MIN_SEARCHED_FLAG: f32 = 0.9;
 
-/// The three networks, ready to run.
+/// The four networks, ready to run.
 pub struct PersonModels {
     pub detector: Network,
     pub landmarker: Network,
@@ -88,7 +88,8 @@ impl PersonModels {
     /// The bodies below the faces BlazeFace finds in the whole picture and in the windows of
     /// [`windows`]: for each face, the landmarks read in the body regions [`body_seeds`]
     /// proposes, the surest kept where the landmarker confirms it at [`MIN_SEARCHED_FLAG`] with
-    /// the body's nose on the face, each person once. The person's box is the face's, as the pose detector's own box is.
+    /// the body's nose on the face, each person once. The person's box is the face's, as the
+    /// pose detector's own box is.
     pub fn below_faces(&self, image: &Image) -> Result<Vec<Person>, FitError> {
         let mut faces = FACE.detect(&self.face_detector, image)?;
         for window in windows(image.width, image.height) {
@@ -156,9 +157,9 @@ impl PersonModels {
     }
 }
 
-/// `people` less those read twice: windows of two scales can give the same person two detection
-/// boxes too unlike to merge (one the face, one the head), but the landmarks read from both put
-/// the body in the same place. The surer reading is kept; largest box first.
+/// `people` less those read twice: windows of two scales (or two faces' seeds) can give the same
+/// person two detections too unlike to merge (one the face, one the head), but the landmarks
+/// read from both put the body in the same place. The surer reading is kept; largest box first.
 fn distinct(mut people: Vec<Person>) -> Vec<Person> {
     people.sort_by(|a, b| b.landmarks.flag.total_cmp(&a.landmarks.flag));
     let mut out: Vec<Person> = Vec::new();
