@@ -107,8 +107,10 @@ fn run(
     }
     let model_dir = dir.join(name.replace("w/o ", "without-"));
     trainer.avatar.save(&model_dir).expect("save");
-    let options = EvalOptions { background: [1.0; 3], lpips: None, samples: 100_000, seed: 0, compare_meshes: true };
-    let scores = evaluate_avatar(&model_dir, data, None, &options, TestPoseMode::Auto, &|_, _, _| {}, &|| {}).expect("evaluate");
+    let options =
+        EvalOptions { background: [1.0; 3], lpips: None, samples: 100_000, seed: 0, compare_meshes: true };
+    let scores = evaluate_avatar(&model_dir, data, None, &options, TestPoseMode::Auto, &|_, _, _| {}, &|| {})
+        .expect("evaluate");
     (scores, per_iter)
 }
 

@@ -252,7 +252,8 @@ impl Avatar {
             posedirs: self.posedirs.as_ref(),
             parents: &self.canonical.parents,
         };
-        let posed = skin_tensors(&rig, personalised.reshape([1, v, 3]), joints.reshape([1, j, 3]), pose, transl);
+        let posed =
+            skin_tensors(&rig, personalised.reshape([1, v, 3]), joints.reshape([1, j, 3]), pose, transl);
         posed.vertices.reshape([v, 3])
     }
 

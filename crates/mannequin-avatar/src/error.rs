@@ -23,7 +23,9 @@ pub enum AvatarError {
     Invalid(String),
     #[error("the loss became {value} at iteration {iteration}; the last good checkpoint is {checkpoint}")]
     NonFiniteLoss { iteration: usize, value: f64, checkpoint: String },
-    #[error("the refined pose of frame {frame} stopped being finite; the last good checkpoint is {checkpoint}")]
+    #[error(
+        "the refined pose of frame {frame} stopped being finite; the last good checkpoint is {checkpoint}"
+    )]
     NonFinitePose { frame: usize, checkpoint: String },
     /// A checkpoint that cannot be resumed, with the way out.
     #[error("{0}; {START_OVER}")]
@@ -38,7 +40,9 @@ impl AvatarError {
     /// A training error with the last good checkpoint named where it stops a run.
     pub fn with_checkpoint(self, last: String) -> Self {
         match self {
-            Self::NonFiniteLoss { iteration, value, .. } => Self::NonFiniteLoss { iteration, value, checkpoint: last },
+            Self::NonFiniteLoss { iteration, value, .. } => {
+                Self::NonFiniteLoss { iteration, value, checkpoint: last }
+            }
             Self::NonFinitePose { frame, .. } => Self::NonFinitePose { frame, checkpoint: last },
             e => e,
         }

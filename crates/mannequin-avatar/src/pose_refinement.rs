@@ -70,7 +70,11 @@ impl PoseRefinement {
         for v in views {
             let pose = tensor_from(v.pose.clone(), 1, v.pose.len(), device);
             params.push(Param::new(&format!("pose/{:05}", v.frame), pose, POSE_LR));
-            params.push(Param::new(&format!("transl/{:05}", v.frame), tensor_from(v.transl.to_vec(), 1, 3, device), TRANSL_LR));
+            params.push(Param::new(
+                &format!("transl/{:05}", v.frame),
+                tensor_from(v.transl.to_vec(), 1, 3, device),
+                TRANSL_LR,
+            ));
         }
         let initial = params.iter().map(|p| p.value.clone().detach()).collect();
         let adam = Adam::new(&params);
@@ -107,7 +111,9 @@ impl PoseRefinement {
             p.lr = lr_factor * if i % 2 == 0 { POSE_LR } else { TRANSL_LR };
         }
         self.adam.update(&mut self.params, grads);
-        let values = host(self.params[2 * k].value.clone()).into_iter().chain(host(self.params[2 * k + 1].value.clone()));
+        let values = host(self.params[2 * k].value.clone())
+            .into_iter()
+            .chain(host(self.params[2 * k + 1].value.clone()));
         if values.into_iter().any(|x| !x.is_finite()) {
             return Err(AvatarError::NonFinitePose { frame: self.frames[k], checkpoint: String::new() });
         }
@@ -116,7 +122,12 @@ impl PoseRefinement {
 
     /// The refined poses in the dataset's pose format, with the dataset's `betas`.
     pub fn poses(&self, betas: &[f32]) -> Poses {
-        let mut out = Poses { betas: betas.to_vec(), global_orient: Vec::new(), body_pose: Vec::new(), transl: Vec::new() };
+        let mut out = Poses {
+            betas: betas.to_vec(),
+            global_orient: Vec::new(),
+            body_pose: Vec::new(),
+            transl: Vec::new(),
+        };
         for pair in self.params.chunks_exact(2) {
             let pose = host(pair[0].value.clone());
             let t = host(pair[1].value.clone());

@@ -84,7 +84,9 @@ pub fn fit_test_poses(
     let personalised = avatar.personalised(avatar.offsets()?).detach();
     let mut fitted = split.poses.select(&[]);
     for view in &views {
-        fitted.append(&fit_view_pose(avatar, personalised.clone(), view, steps, &options)?.poses(&split.poses.betas));
+        fitted.append(
+            &fit_view_pose(avatar, personalised.clone(), view, steps, &options)?.poses(&split.poses.betas),
+        );
         on_frame();
     }
     Ok(fitted)

@@ -176,8 +176,7 @@ impl Trainer {
 
     /// Whether this iteration moves the poses (refinement starts after `START_SHARE`).
     fn refining(&self) -> bool {
-        self.refinement.is_some()
-            && self.iteration as f64 >= START_SHARE * self.options.iterations as f64
+        self.refinement.is_some() && self.iteration as f64 >= START_SHARE * self.options.iterations as f64
     }
 
     /// One iteration on the next view.

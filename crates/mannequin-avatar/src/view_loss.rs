@@ -15,7 +15,8 @@ pub fn view_loss(r: &Rendered, view: &View, o: &TrainOptions) -> Result<(Tensor<
     let crop = &view.crop;
     let device = r.image.device();
     let (channels, h, w) = (view.target_channels(), crop.height, crop.width);
-    let target: Tensor<3> = Tensor::from_data(TensorData::new(view.targets.clone(), [channels, h, w]), &device);
+    let target: Tensor<3> =
+        Tensor::from_data(TensorData::new(view.targets.clone(), [channels, h, w]), &device);
     // Eq. 12 on colour and Eq. 13 on normals in one pass over the stacked image.
     let (pred, weights) = if view.has_normals() {
         let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);

@@ -20,13 +20,13 @@ pub mod writer;
 
 pub use dataset::{Cameras, Dataset, Frame, Split};
 pub use error::DataError;
+pub use evaluation::TestPoses;
 pub use image::{Image, Mask};
 /// The one camera type of the project, shared with the renderer.
 pub use mannequin_splat::Camera;
 pub use maps::{DepthMap, NormalMap};
 pub use origin::{Origin, PoseOrigin};
 pub use poses::Poses;
-pub use evaluation::TestPoses;
 pub use scores::{Scores, TestSet};
 pub use splits::{SplitRange, Splits, standard_splits};
 pub use writer::DatasetWriter;

@@ -38,7 +38,10 @@ impl Origin {
         }
         let text = std::fs::read_to_string(&path).map_err(|e| DataError::os(&path, e))?;
         serde_json::from_str(&text).map(Some).map_err(|e| {
-            DataError::file(&path, format!("{e}: expected {{\"poses\": \"truth\" or \"estimated\", \"by\": \"...\"}}"))
+            DataError::file(
+                &path,
+                format!("{e}: expected {{\"poses\": \"truth\" or \"estimated\", \"by\": \"...\"}}"),
+            )
         })
     }
 

@@ -151,7 +151,8 @@ fn eval_reads_jpeg_predictions_against_a_png_ground_truth() {
         w.write_frame(&full(i)).unwrap();
     }
     let pred = jpeg_dataset("eval-pred", "jpg");
-    let options = EvalOptions { background: [1.0; 3], lpips: None, samples: 100, seed: 0, compare_meshes: true };
+    let options =
+        EvalOptions { background: [1.0; 3], lpips: None, samples: 100, seed: 0, compare_meshes: true };
     let frames: Vec<usize> = (0..FRAMES).collect();
     let s = evaluate(&pred, &gt, &frames, &options, &|_| {}).unwrap();
     assert_eq!(s.frames, FRAMES);

@@ -20,11 +20,11 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use mannequin_body::BodyModel;
-use mannequin_data::{Camera, PoseOrigin};
 use mannequin_data::dataset::{Cameras, Frame};
 use mannequin_data::poses::{BODY_POSE_LEN, Poses};
 use mannequin_data::splits::{SplitRange, Splits};
 use mannequin_data::writer::DatasetWriter;
+use mannequin_data::{Camera, PoseOrigin};
 use scene::{PosedSequence, Scene};
 use subject::Subject;
 

@@ -155,7 +155,9 @@ pub fn run(args: Args) -> Result<()> {
         compare_meshes: args.truth.is_none(),
     };
     let scores = match (&args.avatar, &args.data, &args.pred, &args.gt) {
-        (Some(avatar), Some(data), _, _) => evaluate_with_progress(avatar, data, args.truth.as_deref(), &options, args.test_poses)?,
+        (Some(avatar), Some(data), _, _) => {
+            evaluate_with_progress(avatar, data, args.truth.as_deref(), &options, args.test_poses)?
+        }
         (_, _, Some(pred), Some(gt)) => {
             let frames = test_frames(gt)?;
             let progress = bar(frames.len() as u64, args.set.name());

@@ -69,7 +69,8 @@ impl Adam {
             for (moment, slot, allowed) in
                 [("adam_m/", &mut adam.m[k], FLOAT32), ("adam_v/", &mut adam.v[k], 0.0..=*FLOAT32.end())]
             {
-                let mut moment_param = Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
+                let mut moment_param =
+                    Param { name: p.name.clone(), value: slot.clone().autodiff(), lr: 0.0 };
                 moment_param.load(npz, &format!("{prefix}{moment}"), allowed)?;
                 // Checkpoints store f32; the op wants the parameter's dtype.
                 *slot = moment_param.value.inner().cast(p.value.dtype());

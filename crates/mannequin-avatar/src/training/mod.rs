@@ -43,7 +43,11 @@ impl Training {
         let mut running_psnr: Option<f64> = None;
         while t.iteration < iterations {
             let stats = t.step().inspect_err(|_| progress.abandon()).map_err(|e| {
-                e.with_checkpoint(if checkpoint.exists() { checkpoint.display().to_string() } else { "none".into() })
+                e.with_checkpoint(if checkpoint.exists() {
+                    checkpoint.display().to_string()
+                } else {
+                    "none".into()
+                })
             })?;
             let p = running_psnr.map_or(stats.psnr, |r| 0.9 * r + 0.1 * stats.psnr);
             running_psnr = Some(p);

@@ -112,7 +112,10 @@ impl Subject {
         let views = load_views(&self.dataset, &self.split, |done, _| progress.set_position(done as u64))?;
         progress.finish_and_clear();
         if record.options.refine_poses {
-            tracing::info!("refining the {} training poses with the avatar (--refine-poses off to keep them)", views.len());
+            tracing::info!(
+                "refining the {} training poses with the avatar (--refine-poses off to keep them)",
+                views.len()
+            );
         }
         if views.iter().any(|v| !v.has_normals()) {
             tracing::warn!("{} has no normal maps: the normal loss is off", self.data.display());
