@@ -64,7 +64,12 @@ pub fn fit_view_pose(
         let (loss, _) = view_loss(&rendered, view, options)?;
         let grads = (loss + pose.prior(0)).backward();
         let factor = LR_SCALE * FINAL_LR_FACTOR.powf(step as f64 / steps.max(1) as f64);
-        pose.update(&grads, factor, 0)?;
+        pose.update(&grads, factor, 0).map_err(|e| match e {
+            AvatarError::NonFinitePose { frame, .. } => {
+                AvatarError::Invalid(format!("the pose fitted to test frame {frame} stopped being finite"))
+            }
+            e => e,
+        })?;
     }
     Ok(pose)
 }
