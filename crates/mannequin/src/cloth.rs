@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use mannequin_body::load_body;
-use mannequin_cloth::{Performer, SimulateJob, SimulateSettings, simulate};
+use mannequin_cloth::{SimulateJob, SimulateSettings, simulate};
 use mannequin_io::progress::JobTimer;
 use mannequin_io::staging::Staging;
 
@@ -53,13 +53,7 @@ fn simulate_garment(args: SimulateArgs) -> Result<()> {
     let job = SimulateJob {
         garment: &args.garment,
         pins: args.pin.as_deref(),
-        performer: Performer {
-            model: &model,
-            body: &args.body.body,
-            betas: &args.body.betas,
-            motion: &motion,
-            motion_path: &args.clip.motion,
-        },
+        performer: args.body.performer(&model, &args.clip, &motion),
     };
     let simulation = simulate(&job, &args.settings, &args.out)?;
     let staging = Staging::new(&args.out)?;

@@ -8,7 +8,6 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args as ClapArgs;
 use mannequin_body::load_body;
-use mannequin_cloth::Performer;
 use mannequin_garment::dressing::RegionFit;
 use mannequin_garment::{DressJob, DressSettings, Dressing, Wardrobe, dress};
 use mannequin_io::progress::JobTimer;
@@ -53,16 +52,8 @@ pub fn run(args: Args) -> Result<()> {
     let model = load_body(&args.body.body)?;
     let motion = args.clip.load()?;
     let camera = args.camera.as_deref().map(read_camera).transpose()?.map(|(camera, _)| camera);
-    let job = DressJob {
-        garments: &args.garments,
-        performer: Performer {
-            model: &model,
-            body: &args.body.body,
-            betas: &args.body.betas,
-            motion: &motion,
-            motion_path: &args.clip.motion,
-        },
-    };
+    let job =
+        DressJob { garments: &args.garments, performer: args.body.performer(&model, &args.clip, &motion) };
     let wardrobe = Wardrobe::load(&job, &args.settings)?;
     let mut dressing = dress(&wardrobe, &job, &args.settings, &args.out)?;
     if args.fit_report {

@@ -8,7 +8,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::builder::PossibleValuesParser;
-use mannequin_body::{Motion, POSE_NAMES, named_pose};
+use mannequin_body::{BodyModel, Motion, POSE_NAMES, named_pose};
+use mannequin_cloth::Performer;
 use mannequin_io::limits::MAX_BETA;
 
 /// The body model and its shape.
@@ -20,6 +21,19 @@ pub struct BodyArgs {
     /// Shape coefficients, comma-separated (missing ones are 0), each within ±10.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = parse_beta)]
     pub betas: Vec<f32>,
+}
+
+impl BodyArgs {
+    /// This body (its loaded `model`) playing `clip` (loaded as `motion`): what `cloth simulate`
+    /// and `dress` move their garments on.
+    pub fn performer<'a>(
+        &'a self,
+        model: &'a BodyModel,
+        clip: &'a Clip,
+        motion: &'a Motion,
+    ) -> Performer<'a> {
+        Performer { model, body: &self.body, betas: &self.betas, motion, motion_path: &clip.motion }
+    }
 }
 
 /// One shape coefficient: finite and within [`MAX_BETA`] standard deviations, refused at parse
