@@ -65,7 +65,7 @@ def main():
         fwd = best_ms(args.reps, lambda: torch.no_grad()(render)(False))
         both = best_ms(args.reps, lambda: render(True))
         n = t["means"].shape[0]
-        print(f"{n:>8} {'gsplat CUDA':>12} {fwd:>12.2} {both:>12.2}   (alpha coverage {coverage:.1}%)")
+        print(f"{n:>8} {'gsplat CUDA':>12} {fwd:>12.2f} {both:>12.2f}   (alpha coverage {coverage:.1f}%)")
 
 
 if __name__ == "__main__":
