@@ -31,6 +31,22 @@ pub struct Timings {
     pub optimiser: Duration,
 }
 
+/// The phases of one iteration, in order, as [`Trainer::on_phase`] names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    Skinning,
+    Derivation,
+    Render,
+    Losses,
+    Backward,
+    Optimiser,
+}
+
+impl Phase {
+    pub const ALL: [Phase; 6] =
+        [Phase::Skinning, Phase::Derivation, Phase::Render, Phase::Losses, Phase::Backward, Phase::Optimiser];
+}
+
 #[derive(Debug, Clone)]
 pub struct StepStats {
     /// Iterations done, this one included.
@@ -60,6 +76,10 @@ pub struct Trainer {
     /// Wait for the device at each phase boundary, so that [`Timings`] charges each phase its
     /// own work on a GPU, whose launches return before the work is done (costs throughput).
     pub profile: bool,
+    /// Called after each phase has finished on the device (with [`Trainer::profile`] set), so a
+    /// benchmark can attribute what the device logged (kernel launches) to the phase. `None`
+    /// names the work queued before the iteration's first phase.
+    pub on_phase: Option<Box<dyn Fn(Option<Phase>) + Send + Sync>>,
 }
 
 /// Mean edge length of the canonical mesh (each edge counted once per face side).
@@ -116,6 +136,7 @@ impl Trainer {
             laplacian_scale,
             base_lr,
             profile: false,
+            on_phase: None,
         })
     }
 
@@ -189,18 +210,21 @@ impl Trainer {
         if let Some(r) = &mut self.refinement {
             r.update(&grads, factor, k)?;
         }
-        t.optimiser = self.lap(clock)?;
+        t.optimiser = self.lap(clock, Some(Phase::Optimiser))?;
         self.iteration += 1;
         Ok(StepStats { iteration: self.iteration, loss: value, psnr, timings: t })
     }
 
     /// Time since `clock`, after the device has finished its work when profiling.
-    fn lap(&self, clock: Instant) -> Result<Duration, AvatarError> {
+    fn lap(&self, clock: Instant, phase: Option<Phase>) -> Result<Duration, AvatarError> {
         if self.profile {
             self.avatar
                 .device()
                 .sync()
                 .map_err(|e| AvatarError::Invalid(format!("the device failed: {e:?}")))?;
+            if let Some(f) = &self.on_phase {
+                f(phase);
+            }
         }
         Ok(clock.elapsed())
     }
@@ -219,7 +243,7 @@ impl Trainer {
         let refining = self.refining();
         let mut t = Timings::default();
 
-        self.lap(Instant::now())?;
+        self.lap(Instant::now(), None)?;
         let clock = Instant::now();
         let offsets = self.avatar.offsets()?;
         let personalised = self.avatar.personalised(offsets.clone());
@@ -230,15 +254,15 @@ impl Trainer {
             }
             None => self.avatar.skin(personalised.clone(), &view.pose, view.transl)?,
         };
-        t.skinning = self.lap(clock)?;
+        t.skinning = self.lap(clock, Some(Phase::Skinning))?;
         let clock = Instant::now();
         let gaussians = self.avatar.bind(&vertices);
-        t.derivation = self.lap(clock)?;
+        t.derivation = self.lap(clock, Some(Phase::Derivation))?;
         let clock = Instant::now();
         let posed = crate::avatar::Posed { personalised: personalised.clone(), vertices, gaussians };
         // Only the crop is rendered: the losses look nowhere else.
         let r = self.avatar.render(&posed, &view.crop_camera())?;
-        t.render = self.lap(clock)?;
+        t.render = self.lap(clock, Some(Phase::Render))?;
 
         let clock = Instant::now();
         let (mut loss, mse) = view_loss(&r, view, o)?;
@@ -253,7 +277,7 @@ impl Trainer {
             loss = loss + r.prior(k);
         }
         let value = loss.clone().into_scalar::<f64>();
-        t.losses = self.lap(clock)?;
+        t.losses = self.lap(clock, Some(Phase::Losses))?;
         if !value.is_finite() {
             return Err(AvatarError::NonFiniteLoss {
                 iteration: self.iteration + 1,
@@ -265,7 +289,7 @@ impl Trainer {
 
         let clock = Instant::now();
         let grads = loss.backward();
-        t.backward = self.lap(clock)?;
+        t.backward = self.lap(clock, Some(Phase::Backward))?;
         Ok((grads, value, psnr, k, t))
     }
 
