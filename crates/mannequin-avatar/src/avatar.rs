@@ -17,6 +17,7 @@ use crate::config::{AvatarConfig, Method};
 use crate::error::AvatarError;
 use crate::field::Field;
 use crate::fused_binding::{self, BindConfig};
+use crate::fused_skinning::{self, SkinRig};
 use crate::host_ops;
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
@@ -63,6 +64,8 @@ pub struct Avatar {
     vertices: Tensor<2>,
     weights: Tensor<2>,
     posedirs: Option<Tensor<2>>,
+    /// The rig in the fused skinning's layout, on devices that run it.
+    skin_rig: Option<SkinRig>,
     /// The canonical mesh's offset gate [V, 1], where any vertex is gated.
     offset_gate: Option<Tensor<2>>,
     rest_joints: Tensor<2>,
@@ -166,7 +169,11 @@ impl Avatar {
             .iter()
             .any(|&g| g != 1.0)
             .then(|| tensor_from(canonical.offset_gate.clone(), v, 1, device));
+        let skin_rig = fused_skinning::supported(device)
+            .then(|| SkinRig::new(&canonical.weights, v, posedirs.as_ref(), &canonical.parents, device))
+            .transpose()?;
         Ok(Self {
+            skin_rig,
             index,
             vertices,
             offset_gate,
@@ -247,6 +254,9 @@ impl Avatar {
     pub fn skin_tensor(&self, personalised: Tensor<2>, pose: Tensor<2>, transl: Tensor<2>) -> Tensor<2> {
         let (v, j) = (self.canonical.num_vertices(), self.canonical.num_joints());
         let joints = self.param(self.slots.joints).unwrap_or_else(|| self.rest_joints.clone());
+        if let Some(rig) = &self.skin_rig {
+            return rig.skin(personalised, joints, pose, transl);
+        }
         let rig = Rig {
             weights: &self.weights,
             posedirs: self.posedirs.as_ref(),
