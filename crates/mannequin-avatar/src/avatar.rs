@@ -17,7 +17,7 @@ use crate::config::{AvatarConfig, Method};
 use crate::error::AvatarError;
 use crate::field::Field;
 use crate::fused_binding::{self, BindConfig};
-use crate::fused_skinning::{self, SkinRig};
+use crate::fused_skinning::SkinRig;
 use crate::host_ops;
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
@@ -169,7 +169,7 @@ impl Avatar {
             .iter()
             .any(|&g| g != 1.0)
             .then(|| tensor_from(canonical.offset_gate.clone(), v, 1, device));
-        let skin_rig = fused_skinning::supported(device)
+        let skin_rig = host_ops::on_cube(device)
             .then(|| SkinRig::new(&canonical.weights, v, posedirs.as_ref(), &canonical.parents, device))
             .transpose()?;
         Ok(Self {

@@ -1,11 +1,14 @@
 //! The image terms of the training loss on one view (Eq. 12 on colour, Eq. 13 on normals where
 //! the view has them, and an L1 between rendered alpha and the mask), shared by training and by
-//! fitting a test frame's pose with the avatar frozen, so both chase the same objective.
+//! fitting a test frame's pose with the avatar frozen, so both chase the same objective. On a
+//! GPU the image terms are one fused op ([`crate::losses::image_loss`]).
 
 use burn::tensor::{Tensor, TensorData};
 
 use crate::avatar::Rendered;
 use crate::error::AvatarError;
+use crate::host_ops;
+use crate::losses::image_loss::{ImageLossConfig, image_loss};
 use crate::losses::photometric_weighted;
 use crate::options::TrainOptions;
 use crate::views::View;
@@ -25,7 +28,15 @@ pub fn view_loss(r: &Rendered, view: &View, o: &TrainOptions) -> Result<(Tensor<
         (r.rgb(), vec![1.0 / 3.0; 3])
     };
     let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
-    let loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
     let mask: Tensor<2> = Tensor::from_data(TensorData::new(view.mask.clone(), [h, w]), &device);
+    if host_ops::on_cube(&device) {
+        let config = ImageLossConfig {
+            weights: weights.iter().map(|&x| x as f32).collect(),
+            lambda_ssim: o.lambda_ssim as f32,
+            lambda_mask: o.lambda_mask as f32,
+        };
+        return Ok((image_loss(pred, r.alpha.clone(), target, mask, &config)?, mse));
+    }
+    let loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
     Ok((loss + (r.alpha.clone() - mask).abs().mean() * o.lambda_mask, mse))
 }

@@ -10,7 +10,7 @@ mod cube;
 mod kernels;
 
 use burn::backend::tensor::{FloatTensor, IntTensor};
-use burn::backend::{Backend, Dispatch, DispatchDevice, backend_extension};
+use burn::backend::{Backend, Dispatch, backend_extension};
 use burn::tensor::{Device, Int, Tensor, TensorData};
 
 use crate::AvatarError;
@@ -45,11 +45,6 @@ pub trait SkinningBackend: Backend {
         features: usize,
         grad: FloatTensor<Self>,
     ) -> (FloatTensor<Self>, FloatTensor<Self>, FloatTensor<Self>, FloatTensor<Self>);
-}
-
-/// Whether `device` runs the fused skinning (a CubeCL device, with or without autodiff).
-pub fn supported(device: &Device) -> bool {
-    matches!(device.clone().inner().as_dispatch(), DispatchDevice::Cube(_))
 }
 
 /// A body's skinning rig on one device, in the layout the kernels read, built once.

@@ -4,6 +4,7 @@
 
 pub mod blur;
 mod equilateral;
+pub mod image_loss;
 mod laplacian;
 pub mod mesh_loss;
 mod normal_consistency;
