@@ -1,13 +1,17 @@
 //! The fused binding op (f32) against the tensor composition of Eqs. 5–11 in f64, differentiated
 //! by Burn's autodiff: same Gaussians and same vertex gradients on the default body's template,
 //! jittered so that no face or edge is special, with every ablation's set of Gaussians.
+//! The CubeCL op is held to the Flex one.
+
+use std::sync::Arc;
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
-use mannequin_avatar::fused_binding::{BindConfig, bind};
+use mannequin_avatar::fused_binding::{BindConfig, PACKED, bind};
 use mannequin_avatar::host_ops::supported;
 use mannequin_avatar::mesh_gaussians::{
     Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians,
 };
+use mannequin_avatar::one_ring_mesh::OneRingMesh;
 use mannequin_body::BodyModel;
 use mannequin_io::rng::SplitMix64;
 
@@ -107,6 +111,51 @@ fn fused_binding_matches_the_tensor_composition_and_its_autodiff() {
                 &gradient(false),
                 5e-5,
             );
+        }
+    }
+}
+
+/// The op on the GPU backend (lavapipe where there is no GPU) against the Flex op, through
+/// autodiff: every plane's values, and the vertex gradient of a random upstream gradient on each
+/// plane alone (at its own scale), with every ablation's set of Gaussians. Both run in f32 but
+/// sum in different orders.
+#[test]
+fn fused_binding_on_wgpu_matches_flex() {
+    let (flat, faces) = jittered_template();
+    let nv = flat.len() / 3;
+    let mesh = Arc::new(OneRingMesh::new(nv, &faces));
+    let mut rng = SplitMix64::new(7);
+    for (with_faces, with_vertices) in [(true, true), (true, false), (false, true)] {
+        let config =
+            BindConfig { mesh: mesh.clone(), face_gaussians: with_faces, vertex_gaussians: with_vertices };
+        let g = config.num_gaussians();
+        let w: Vec<f32> = (0..g * PACKED).map(|_| rng.range(-1.0, 1.0) as f32).collect();
+        let run = |device: Device| {
+            let device = device.autodiff();
+            let vertices = || {
+                Tensor::<2>::from_data(TensorData::new(flat.clone(), [nv, 3]), (&device, DType::F32))
+                    .require_grad()
+            };
+            let values = outputs(bind(vertices(), &config)).map(host);
+            let mut at = 0;
+            let grads = std::array::from_fn::<_, 4, _>(|k| {
+                let v = vertices();
+                let plane = outputs(bind(v.clone(), &config))[k].clone();
+                let width = plane.dims()[1];
+                let part = TensorData::new(w[at..at + g * width].to_vec(), [g, width]);
+                at += g * width;
+                let grads = (plane * Tensor::<2>::from_data(part, (&device, DType::F32))).sum().backward();
+                host(v.grad(&grads).expect("a vertex gradient"))
+            });
+            (values, grads)
+        };
+        let (want, want_grads) = run(Device::flex());
+        let (got, got_grads) = run(mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}")));
+        let what = format!("faces {with_faces}, vertices {with_vertices}");
+        for (k, name) in NAMES.iter().enumerate() {
+            assert_close(&format!("wgpu {what}: {name}"), &got[k], &want[k], 1e-5);
+            let through = format!("wgpu {what}: vertex gradient through {name}");
+            assert_close(&through, &got_grads[k], &want_grads[k], 1e-4);
         }
     }
 }

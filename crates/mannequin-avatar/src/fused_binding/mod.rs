@@ -1,11 +1,14 @@
 //! Tavatar's binding (Eqs. 5–11) as one differentiable op with a hand-written backward, on Flex
-//! (CPU). Composed from tensor ops ([`crate::mesh_gaussians`]) the binding costs ~100 small
-//! allocating ops forward and as many backward, a fifth of a CPU training step; here it is one
-//! pass over faces and one over vertices each way ([`crate::host_ops`] says where it runs).
+//! (CPU) and CubeCL. Composed from tensor ops ([`crate::mesh_gaussians`]) the binding costs ~100
+//! small allocating ops forward and as many backward, a fifth of a CPU training step; here it is
+//! one pass over faces and one over vertices each way (a third, gathering onto vertices,
+//! backward on CubeCL).
 
 mod autodiff;
+mod cube;
 mod flex;
 mod host;
+mod kernels;
 
 use std::sync::Arc;
 
@@ -52,7 +55,7 @@ impl BindConfig {
 }
 
 /// Backends that run the fused binding.
-#[backend_extension(Flex, Autodiff)]
+#[backend_extension(Flex, Cube, Autodiff)]
 pub trait BindingBackend: Backend {
     /// `[G · PACKED]` Gaussians of posed vertices `[V, 3]` as [`PLANES`], face Gaussians first in
     /// each.
@@ -66,8 +69,8 @@ pub trait BindingBackend: Backend {
     ) -> FloatTensor<Self>;
 }
 
-/// Tavatar's face and vertex Gaussians of posed `f32` vertices `[V, 3]` on a
-/// [`crate::host_ops::supported`] device, differentiable with respect to the vertices.
+/// Tavatar's face and vertex Gaussians of posed `f32` vertices `[V, 3]` on Flex or a CubeCL
+/// device, differentiable with respect to the vertices.
 pub fn bind(vertices: Tensor<2>, config: &BindConfig) -> GaussianGeometry {
     let g = config.num_gaussians();
     let planes = Tensor::<1>::from_dispatch(<Dispatch as BindingBackend>::tavatar_bind_forward(

@@ -1,0 +1,223 @@
+//! The binding on the CubeCL backends (wgpu, CUDA, …): forward one launch over faces and one
+//! over vertices; backward one over vertices, one over faces and a gather onto vertices. Works
+//! in f32; other float types are converted on the way in and out. The mesh's index tables go to
+//! each device once and stay there while the mesh lives.
+
+use std::sync::{Arc, Mutex, PoisonError, Weak};
+
+use burn::backend::ops::{FloatTensorOps, IntTensorOps};
+use burn::backend::tensor::FloatTensor;
+use burn::backend::wgpu::{CubeBackend, CubeTensor};
+use burn::tensor::{FloatDType, IntDType, TensorData};
+use burn_cubecl::CubeDevice;
+use burn_cubecl::cubecl;
+use cubecl::prelude::*;
+
+use super::kernels::{ParamsLaunch, bind_faces, bind_vertices, face_terms, gather_vertices, vertex_terms};
+use super::{BindConfig, BindingBackend, PACKED, plane_starts};
+use crate::losses::blur::as_f32;
+use crate::mesh_gaussians::{FACE_SCALE, NORM_EPS, NORMAL_SCALE, VERTEX_SCALE};
+use crate::one_ring_mesh::OneRingMesh;
+
+type B = CubeBackend;
+
+fn u32_of(v: usize) -> u32 {
+    u32::try_from(v).expect("binding sizes index within u32")
+}
+
+/// A mesh's index tables on one device, laid out as `kernels.rs` reads them.
+#[derive(Clone)]
+struct Tables {
+    faces: CubeTensor,
+    corner_start: CubeTensor,
+    corners: CubeTensor,
+    ring_start: CubeTensor,
+    rings: CubeTensor,
+}
+
+/// `[0, n₀, n₀ + n₁, …]`.
+fn starts(counts: impl Iterator<Item = usize>) -> Vec<u32> {
+    let ends = counts.scan(0, |end, n| {
+        *end += n;
+        Some(*end)
+    });
+    std::iter::once(0).chain(ends).map(u32_of).collect()
+}
+
+impl Tables {
+    fn upload(mesh: &OneRingMesh, device: &CubeDevice) -> Self {
+        let nv = mesh.num_vertices;
+        let mut counts = vec![0; nv];
+        for &i in mesh.faces.iter().flatten() {
+            counts[i as usize] += 1;
+        }
+        let corner_start = starts(counts.into_iter());
+        // Faces in ascending order, so each vertex's corners come in face order.
+        let mut next: Vec<u32> = corner_start[..nv].to_vec();
+        let mut corners = vec![0; 3 * mesh.faces.len()];
+        for (k, &i) in mesh.faces.iter().flatten().enumerate() {
+            corners[next[i as usize] as usize] = u32_of(k);
+            next[i as usize] += 1;
+        }
+        let rings: Vec<u32> = (0..nv).flat_map(|i| mesh.ring(i).iter().copied()).collect();
+        let upload = |t: Vec<u32>| {
+            let n = t.len();
+            B::int_from_data(TensorData::new(t, [n]), device)
+        };
+        Self {
+            faces: upload(mesh.faces.concat()),
+            corner_start: upload(corner_start),
+            corners: upload(corners),
+            ring_start: upload(starts((0..nv).map(|i| mesh.ring(i).len()))),
+            rings: upload(rings),
+        }
+    }
+
+    /// The tables of `mesh` on `device`, uploaded on first use. An entry holds a `Weak` of its
+    /// mesh, which keeps the allocation and so its address from being reused while the entry
+    /// exists; entries of dropped meshes go at the next call.
+    fn of(mesh: &Arc<OneRingMesh>, device: &CubeDevice) -> Self {
+        static CACHE: Mutex<Vec<(Weak<OneRingMesh>, CubeDevice, Tables)>> = Mutex::new(Vec::new());
+        let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
+        cache.retain(|(m, _, _)| m.strong_count() > 0);
+        let key = Arc::downgrade(mesh);
+        if let Some((_, _, t)) = cache.iter().find(|(m, d, _)| m.ptr_eq(&key) && d == device) {
+            return t.clone();
+        }
+        let t = Self::upload(mesh, device);
+        cache.push((key, device.clone(), t.clone()));
+        t
+    }
+}
+
+fn params(config: &BindConfig) -> ParamsLaunch {
+    let [_, frames, scales, normals] = plane_starts(config.num_gaussians()).map(u32_of);
+    let faces = config.mesh.faces.len();
+    ParamsLaunch::new(
+        u32_of(faces),
+        u32_of(config.mesh.num_vertices),
+        u32_of(if config.face_gaussians { faces } else { 0 }),
+        frames,
+        scales,
+        normals,
+        NORM_EPS as f32,
+        FACE_SCALE as f32,
+        VERTEX_SCALE as f32,
+        NORMAL_SCALE as f32,
+    )
+}
+
+/// Launch geometry for one unit per element.
+fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
+    let dim = CubeDim::new_1d(256);
+    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
+}
+
+fn empty_f32(n: usize, like: &CubeTensor) -> CubeTensor {
+    B::float_empty([n].into(), &like.device, FloatDType::F32)
+}
+
+impl BindingBackend for CubeBackend {
+    fn tavatar_bind_forward(vertices: FloatTensor<Self>, config: BindConfig) -> FloatTensor<Self> {
+        let (v, back) = as_f32(vertices);
+        let t = Tables::of(&config.mesh, &v.device);
+        let out = empty_f32(config.num_gaussians() * PACKED, &v);
+        let client = &v.client;
+        if config.face_gaussians {
+            let (count, dim) = grid(&v, config.mesh.faces.len());
+            bind_faces::launch(
+                client,
+                count,
+                dim,
+                v.clone().into_buffer_arg(),
+                t.faces.clone().into_buffer_arg(),
+                out.clone().into_buffer_arg(),
+                params(&config),
+            );
+        }
+        if config.vertex_gaussians {
+            let (count, dim) = grid(&v, config.mesh.num_vertices);
+            bind_vertices::launch(
+                client,
+                count,
+                dim,
+                v.clone().into_buffer_arg(),
+                t.faces.into_buffer_arg(),
+                t.corner_start.into_buffer_arg(),
+                t.corners.into_buffer_arg(),
+                t.ring_start.into_buffer_arg(),
+                t.rings.into_buffer_arg(),
+                out.clone().into_buffer_arg(),
+                params(&config),
+            );
+        }
+        back(out)
+    }
+
+    fn tavatar_bind_backward(
+        vertices: FloatTensor<Self>,
+        grad: FloatTensor<Self>,
+        config: BindConfig,
+    ) -> FloatTensor<Self> {
+        let (v, back) = as_f32(vertices);
+        let (grad, _) = as_f32(grad);
+        let t = Tables::of(&config.mesh, &v.device);
+        let (nf, nv) = (config.mesh.faces.len(), config.mesh.num_vertices);
+        let client = &v.client;
+        // Read only with vertex Gaussians.
+        let terms = empty_f32(6 * nv, &v);
+        let nearest = B::int_empty([nv].into(), &v.device, IntDType::U32);
+        if config.vertex_gaussians {
+            let (count, dim) = grid(&v, nv);
+            vertex_terms::launch(
+                client,
+                count,
+                dim,
+                v.clone().into_buffer_arg(),
+                t.faces.clone().into_buffer_arg(),
+                t.corner_start.clone().into_buffer_arg(),
+                t.corners.clone().into_buffer_arg(),
+                t.ring_start.clone().into_buffer_arg(),
+                t.rings.clone().into_buffer_arg(),
+                grad.clone().into_buffer_arg(),
+                terms.clone().into_buffer_arg(),
+                nearest.clone().into_buffer_arg(),
+                params(&config),
+            );
+        }
+        let corner_grads = empty_f32(9 * nf, &v);
+        let (count, dim) = grid(&v, nf);
+        face_terms::launch(
+            client,
+            count,
+            dim,
+            v.clone().into_buffer_arg(),
+            t.faces.into_buffer_arg(),
+            grad.clone().into_buffer_arg(),
+            terms.clone().into_buffer_arg(),
+            corner_grads.clone().into_buffer_arg(),
+            params(&config),
+            config.face_gaussians,
+            config.vertex_gaussians,
+        );
+        let d = empty_f32(3 * nv, &v);
+        let (count, dim) = grid(&v, nv);
+        gather_vertices::launch(
+            client,
+            count,
+            dim,
+            t.corner_start.into_buffer_arg(),
+            t.corners.into_buffer_arg(),
+            t.ring_start.into_buffer_arg(),
+            t.rings.into_buffer_arg(),
+            grad.into_buffer_arg(),
+            corner_grads.into_buffer_arg(),
+            terms.into_buffer_arg(),
+            nearest.into_buffer_arg(),
+            d.clone().into_buffer_arg(),
+            params(&config),
+            config.vertex_gaussians,
+        );
+        back(B::float_reshape(d, [nv, 3].into()))
+    }
+}
