@@ -73,3 +73,46 @@ fn fused_colour_matches_the_tensor_composition_and_its_autodiff() {
         assert_close(&format!("degree {degree}: coefficient gradients"), &dc, &dc_ref, 1e-5);
     }
 }
+
+/// The CubeCL kernels (wgpu; lavapipe where there is no GPU) against the Flex op, through
+/// Autodiff: same colours and same gradients of the means and coefficients, degrees 0–3, the
+/// clamp exercised. Both run the same f32 formulas, so they agree to rounding (1e-4 relative).
+#[test]
+fn fused_colour_on_wgpu_matches_flex() {
+    let mut rng = SplitMix64::new(11);
+    let g = 2000;
+    let means: Vec<f32> = (0..g)
+        .flat_map(|_| [rng.range(-0.4, 0.4), rng.range(-0.9, 0.9), rng.range(-0.2, 0.2)])
+        .map(|x| x as f32)
+        .collect();
+    let gpu = mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}"));
+    for degree in 0..=3 {
+        let config = ColourConfig { eye: [0.3, 0.2, 3.0], degree };
+        let k3 = 3 * (degree + 1) * (degree + 1);
+        let coeffs: Vec<f32> = (0..g * k3).map(|_| rng.range(-2.5, 2.5) as f32).collect();
+        let w: Vec<f32> = (0..g * 3).map(|_| rng.range(-1.0, 1.0) as f32).collect();
+        let run = |device: &Device| {
+            let device = device.clone().autodiff();
+            let t = |v: &Vec<f32>, width| {
+                Tensor::<2>::from_data(TensorData::new(v.clone(), [g, width]), (&device, DType::F32))
+            };
+            let (m, c) = (t(&means, 3).require_grad(), t(&coeffs, k3).require_grad());
+            let colour = sh_colour(m.clone(), c.clone(), &config);
+            let grads = (colour.clone() * t(&w, 3)).sum().backward();
+            (host(colour), host(m.grad(&grads).unwrap()), host(c.grad(&grads).unwrap()))
+        };
+        let (want, dm_want, dc_want) = run(&Device::flex());
+        let (got, dm, dc) = run(&gpu);
+        assert!(
+            want.iter().filter(|&&x| x == 0.0).count() > g / 20,
+            "degree {degree}: the clamp is exercised"
+        );
+        assert_close(&format!("degree {degree}: wgpu colours"), &got, &want, 1e-4);
+        if degree > 0 {
+            assert_close(&format!("degree {degree}: wgpu mean gradients"), &dm, &dm_want, 1e-4);
+        } else {
+            assert!(dm.iter().chain(&dm_want).all(|&x| x == 0.0), "degree 0: mean gradients are zero");
+        }
+        assert_close(&format!("degree {degree}: wgpu coefficient gradients"), &dc, &dc_want, 1e-4);
+    }
+}

@@ -5,6 +5,9 @@
 
 use crate::real::Real;
 
+/// The same basis and gradient as CubeCL functions (f32), for other crates' kernels.
+pub use crate::op::{sh_basis, sh_basis_vjp};
+
 /// Number of basis functions for `degree` (1, 4, 9, 16).
 pub const fn basis_len(degree: usize) -> usize {
     (degree + 1) * (degree + 1)

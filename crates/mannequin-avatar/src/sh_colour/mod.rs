@@ -1,12 +1,15 @@
 //! 3DGS's view-dependent colour, `max(Σ_k Y_k(d)·c_k + ½, 0)` with `d` the unit direction from
-//! the eye to the Gaussian, as one differentiable op with a hand-written backward on Flex (CPU).
+//! the eye to the Gaussian, as one differentiable op with a hand-written backward (Flex and CubeCL).
 //! Composed from tensor ops it is ~40 small allocating ops each way over `[G, 9, 3]` tensors,
-//! a tenth of a CPU training step; here it is one pass over the Gaussians each way
-//! ([`crate::host_ops`] says where it runs; [`sh_colour_tensors`] is the composition).
+//! a tenth of a CPU training step; here it is one pass over the Gaussians each way, on the host
+//! (Flex) or as one CubeCL kernel launch (wgpu) ([`crate::host_ops`] says where it runs;
+//! [`sh_colour_tensors`] is the composition).
 
 mod autodiff;
+mod cube;
 mod flex;
 mod host;
+mod kernels;
 
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
@@ -21,7 +24,7 @@ pub struct ColourConfig {
 }
 
 /// Backends that run the fused colour.
-#[backend_extension(Flex, Autodiff)]
+#[backend_extension(Flex, Cube, Autodiff)]
 pub trait ColourBackend: Backend {
     /// `[G, 3]` colours of means `[G, 3]` and coefficients `[G, (degree + 1)² · 3]` (basis-major,
     /// then channel, as [`crate::Avatar::sh_coefficients`] stores them).
@@ -40,8 +43,8 @@ pub trait ColourBackend: Backend {
     ) -> (FloatTensor<Self>, FloatTensor<Self>);
 }
 
-/// The colours `[G, 3]` of `f32` means and SH coefficients on a Flex device, differentiable with
-/// respect to both.
+/// The colours `[G, 3]` of `f32` means and SH coefficients on a Flex or wgpu device,
+/// differentiable with respect to both.
 pub fn sh_colour(means: Tensor<2>, coeffs: Tensor<2>, config: &ColourConfig) -> Tensor<2> {
     Tensor::from_dispatch(<Dispatch as ColourBackend>::sh_colour_forward(
         means.into_dispatch(),

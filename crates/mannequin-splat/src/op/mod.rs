@@ -35,6 +35,7 @@ mod saved;
 mod scan;
 
 pub use config::SplatConfig;
+pub use project_kernels::{sh_basis, sh_basis_vjp};
 
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};

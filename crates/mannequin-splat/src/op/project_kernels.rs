@@ -150,7 +150,7 @@ fn ewa(
 
 /// The SH basis (gsplat's order and signs) at unit direction `(x, y, z)`, as in `sh.rs`.
 #[cube]
-fn sh_basis(x: f32, y: f32, z: f32, out: &mut Array<f32>, #[comptime] degree: u32) {
+pub fn sh_basis(x: f32, y: f32, z: f32, out: &mut Array<f32>, #[comptime] degree: u32) {
     out[0] = 0.282_094_8f32;
     if degree >= 1 {
         out[1] = -0.488_602_5f32 * y;
@@ -180,7 +180,7 @@ fn sh_basis(x: f32, y: f32, z: f32, out: &mut Array<f32>, #[comptime] degree: u3
 
 /// `Σ_k g_k ∇Y_k` at `(x, y, z)` into `out[0..3]`, as `sh::basis_vjp`.
 #[cube]
-fn sh_basis_vjp(x: f32, y: f32, z: f32, g: &Array<f32>, out: &mut Array<f32>, #[comptime] degree: u32) {
+pub fn sh_basis_vjp(x: f32, y: f32, z: f32, g: &Array<f32>, out: &mut Array<f32>, #[comptime] degree: u32) {
     let c1 = 0.488_602_5f32;
     let mut vx = -c1 * g[3];
     let mut vy = -c1 * g[1];

@@ -1,0 +1,97 @@
+//! The colour on the CubeCL backends (wgpu, CUDA, …): one kernel launch each way, nothing read
+//! back. Works in f32; other float types are converted on the way in and out.
+
+use burn::backend::TensorMetadata;
+use burn::backend::ops::FloatTensorOps;
+use burn::backend::tensor::FloatTensor;
+use burn::backend::wgpu::{CubeBackend, CubeTensor};
+use burn::tensor::FloatDType;
+use burn_cubecl::cubecl;
+use cubecl::prelude::*;
+use mannequin_splat::sh::{MAX_DEGREE, basis_len};
+
+use super::kernels::{colour_backward, colour_forward};
+use super::{ColourBackend, ColourConfig};
+use crate::losses::blur::as_f32;
+
+type B = CubeBackend;
+
+/// The Gaussian count and the comptime degree, checked against the coefficients' width.
+fn sizes(means: &CubeTensor, coeffs: &CubeTensor, config: &ColourConfig) -> (usize, u32) {
+    assert!(config.degree <= MAX_DEGREE, "SH degree {} above {MAX_DEGREE}", config.degree);
+    let n = means.shape()[0];
+    assert_eq!(coeffs.shape().to_vec(), [n, 3 * basis_len(config.degree)], "SH coefficients' shape");
+    let degree = u32::try_from(config.degree).expect("degree ≤ 3");
+    (n, degree)
+}
+
+/// Launch geometry for one unit per Gaussian.
+fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
+    let dim = CubeDim::new_1d(256);
+    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
+}
+
+fn u32_of(n: usize) -> u32 {
+    u32::try_from(n).expect("Gaussian count fits u32")
+}
+
+impl ColourBackend for CubeBackend {
+    fn sh_colour_forward(
+        means: FloatTensor<Self>,
+        coeffs: FloatTensor<Self>,
+        config: ColourConfig,
+    ) -> FloatTensor<Self> {
+        let (n, degree) = sizes(&means, &coeffs, &config);
+        let (means, back) = as_f32(means);
+        let (coeffs, _) = as_f32(coeffs);
+        let out = B::float_empty([n, 3].into(), &means.device, FloatDType::F32);
+        let (count, dim) = grid(&means, n);
+        let [ex, ey, ez] = config.eye;
+        colour_forward::launch(
+            &means.client,
+            count,
+            dim,
+            means.clone().into_buffer_arg(),
+            coeffs.into_buffer_arg(),
+            out.clone().into_buffer_arg(),
+            u32_of(n),
+            ex,
+            ey,
+            ez,
+            degree,
+        );
+        back(out)
+    }
+
+    fn sh_colour_backward(
+        means: FloatTensor<Self>,
+        coeffs: FloatTensor<Self>,
+        grad: FloatTensor<Self>,
+        config: ColourConfig,
+    ) -> (FloatTensor<Self>, FloatTensor<Self>) {
+        let (n, degree) = sizes(&means, &coeffs, &config);
+        let (means, back) = as_f32(means);
+        let (coeffs, _) = as_f32(coeffs);
+        let (grad, _) = as_f32(grad);
+        let d_means = B::float_empty([n, 3].into(), &means.device, FloatDType::F32);
+        let d_coeffs = B::float_empty(coeffs.shape(), &means.device, FloatDType::F32);
+        let (count, dim) = grid(&means, n);
+        let [ex, ey, ez] = config.eye;
+        colour_backward::launch(
+            &means.client,
+            count,
+            dim,
+            means.clone().into_buffer_arg(),
+            coeffs.into_buffer_arg(),
+            grad.into_buffer_arg(),
+            d_means.clone().into_buffer_arg(),
+            d_coeffs.clone().into_buffer_arg(),
+            u32_of(n),
+            ex,
+            ey,
+            ez,
+            degree,
+        );
+        (back(d_means), back(d_coeffs))
+    }
+}
