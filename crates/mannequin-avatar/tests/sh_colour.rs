@@ -1,6 +1,7 @@
 //! The fused colour op (f32) against the tensor composition in f64, differentiated by Burn's
 //! autodiff: same colours and same gradients of the means and the coefficients, for degrees 0–2,
-//! with coefficients that push some channels below zero so the clamp is exercised.
+//! with coefficients that push some channels below zero so the clamp is exercised; and the CubeCL
+//! kernels (wgpu) against Flex, degrees 0–3.
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::sh_colour::{ColourConfig, sh_colour, sh_colour_tensors};
