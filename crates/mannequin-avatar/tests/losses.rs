@@ -2,14 +2,19 @@
 //! from Burn's ops around the blur op) against the evaluation metric of `mannequin-data`
 //! (checked against scikit-image), the blur against a direct 11×11 window,
 //! gradients against central differences in f64, the mesh regularisers against values worked
-//! out by hand, and bad input against clear errors.
+//! out by hand, the GPU (wgpu) forms against Flex, and bad input against clear errors.
+
+use std::collections::HashMap;
+use std::sync::Arc;
 
 use burn::tensor::{DType, Device, Tensor, TensorData};
 use mannequin_avatar::AvatarError;
+use mannequin_avatar::losses::mesh_loss::{HostMesh, HostTerm, MeshLoss, mesh_loss};
 use mannequin_avatar::losses::{
     MeshRegularisers, gaussian_blur_valid, gaussian_window, photometric, photometric_weighted, ssim,
     ssim_map, ssim_with_blur,
 };
+use mannequin_avatar::one_ring_mesh::OneRingMesh;
 use mannequin_data::Image;
 use mannequin_data::metrics::ssim::ssim as metric_ssim;
 use mannequin_io::rng::SplitMix64;
@@ -504,4 +509,78 @@ fn fused_mesh_regularisers_match_their_tensor_compositions() {
             }
         }
     }
+}
+
+/// The body's faces as the fused op's mesh, its hinges found here independently of
+/// [`MeshRegularisers`] (the Flex values below tie the two together).
+fn host_mesh(num_vertices: usize, faces: &[[u32; 3]]) -> Arc<HostMesh> {
+    let mut sides: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for &[a, b, c] in faces {
+        for (p, q, o) in [(a, b, c), (b, c, a), (c, a, b)] {
+            sides.entry((p.min(q), p.max(q))).or_default().push(o);
+        }
+    }
+    let mut hinges: Vec<[u32; 4]> = sides
+        .iter()
+        .flat_map(|(&(a, b), o)| {
+            (0..o.len()).flat_map(move |i| (i + 1..o.len()).map(move |j| [a, b, o[i], o[j]]))
+        })
+        .collect();
+    hinges.sort_unstable();
+    let mut connected = vec![false; num_vertices];
+    faces.iter().flatten().for_each(|&v| connected[v as usize] = true);
+    Arc::new(HostMesh {
+        rings: Arc::new(OneRingMesh::new(num_vertices, faces)),
+        hinges,
+        num_connected: connected.iter().filter(|&&c| c).count(),
+    })
+}
+
+/// The fused regularisers' CubeCL kernels (wgpu; lavapipe where there is no GPU) against the
+/// Flex op, through Autodiff, on the default body's template jittered by up to 3 mm: same loss
+/// and vertex gradients to 1e-4 (the GPU works in f32, Flex in f64).
+#[test]
+fn fused_mesh_regularisers_on_wgpu_match_flex() {
+    let body = mannequin_body::BodyModel::default_body();
+    let mesh = host_mesh(body.num_vertices(), &body.faces);
+    let topo = topology(body.num_vertices(), &body.faces);
+    let mut rng = SplitMix64::new(9);
+    let x: Vec<f64> =
+        body.v_template.iter().flatten().map(|&c| f64::from(c) + rng.range(-0.003, 0.003)).collect();
+    let shape = [x.len() / 3, 3];
+    let gpu = mannequin_splat::gpu_device().unwrap_or_else(|e| panic!("{e}"));
+    for (term, name) in [
+        (HostTerm::Laplacian, "Laplacian"),
+        (HostTerm::NormalConsistency, "normal consistency"),
+        (HostTerm::Equilateral, "equilateral"),
+    ] {
+        let run = |device: &Device| {
+            let v = tensor(&x, shape, &device.clone().autodiff(), DType::F32).require_grad();
+            let loss = mesh_loss(v.clone(), MeshLoss { term, mesh: mesh.clone() });
+            // Scaled, so the upstream gradient is not 1.
+            let grads = (loss.clone() * 3.0).backward();
+            (scalar(loss), values(v.grad(&grads).unwrap()))
+        };
+        let (want, want_grad) = run(&Device::flex());
+        let same_mesh = match term {
+            HostTerm::Laplacian => topo.laplacian(vertices_f32(&x, shape)),
+            HostTerm::NormalConsistency => topo.normal_consistency(vertices_f32(&x, shape)),
+            HostTerm::Equilateral => topo.equilateral(vertices_f32(&x, shape)),
+        };
+        assert_eq!(scalar(same_mesh.unwrap()), want, "{name}: the test's mesh is the regularisers'");
+        let (got, grad) = run(&gpu);
+        assert!((got - want).abs() <= 1e-4 * want.abs(), "{name}: wgpu {got} vs Flex {want}");
+        let rms = (want_grad.iter().map(|g| g * g).sum::<f64>() / want_grad.len() as f64).sqrt();
+        assert!(rms > 0.0, "{name}: the gradient is not trivially zero");
+        for (i, (a, b)) in grad.iter().zip(&want_grad).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-4 * (b.abs() + rms),
+                "{name}: gradient entry {i}: wgpu {a} vs Flex {b}"
+            );
+        }
+    }
+}
+
+fn vertices_f32(x: &[f64], shape: [usize; 2]) -> Tensor<2> {
+    tensor(x, shape, &Device::flex(), DType::F32)
 }

@@ -15,7 +15,7 @@
 use burn::tensor::Tensor;
 use glam::DVec3;
 
-use super::mesh_loss::{HostMesh, add, sum_over_elements, vertex};
+use super::mesh_loss::{HostMesh, HostTerm, add, sum_over_elements, vertex};
 use super::regularisers::MeshRegularisers;
 use super::rows::{EPS, dot, length};
 use crate::AvatarError;
@@ -23,7 +23,7 @@ use crate::AvatarError;
 impl MeshRegularisers {
     /// `mean_f [Var(‖e₁‖, ‖e₂‖, ‖e₃‖) + Σ_φ (1 − cos φ)²]` over faces, as `[1]`.
     pub fn equilateral(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
-        self.fused_or(equilateral_host, vertices, |v| self.equilateral_tensors(v))
+        self.fused_or(HostTerm::Equilateral, vertices, |v| self.equilateral_tensors(v))
     }
 
     /// [`Self::equilateral`] composed from tensor ops.
@@ -55,7 +55,7 @@ impl MeshRegularisers {
 /// The loss on the host. Gradients are gathered per edge: `g_l` for each length and `g_E` for
 /// each edge vector directly (through the dot products of the cosines), then `∂l/∂E = E/l`.
 /// The variance's mean drops out of its gradient (`Σ (l − m) = 0`).
-fn equilateral_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+pub(super) fn equilateral_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
     let faces = &mesh.rings.faces;
     let weight = 1.0 / faces.len() as f64;
     let total = sum_over_elements(faces.len(), mesh.rings.num_vertices, grad, |f, grad| {

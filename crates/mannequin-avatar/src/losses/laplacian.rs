@@ -6,7 +6,7 @@ use burn::tensor::{IndexingUpdateOp, Tensor};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::mesh_loss::{HostMesh, vertex};
+use super::mesh_loss::{HostMesh, HostTerm, vertex};
 use super::regularisers::MeshRegularisers;
 use crate::AvatarError;
 
@@ -27,7 +27,7 @@ impl MeshRegularisers {
     /// `mean_i ‖δ_i‖²` over the vertices that have neighbours, as `[1]`. The squared norm (not
     /// PyTorch3D's plain norm) keeps the loss smooth where δ = 0.
     pub fn laplacian(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
-        self.fused_or(laplacian_host, vertices, |v| self.laplacian_tensors(v))
+        self.fused_or(HostTerm::Laplacian, vertices, |v| self.laplacian_tensors(v))
     }
 
     /// [`Self::laplacian`] composed from tensor ops.
@@ -54,7 +54,7 @@ fn deltas(mesh: &HostMesh, v: &[f64]) -> Vec<DVec3> {
 
 /// The loss on the host, with `∂L/∂v_k = (2/N)(δ_k − Σ_{i∈N(k)} δ_i/|N(i)|)` (rings are
 /// symmetric, so each vertex gathers from its own ring).
-fn laplacian_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+pub(super) fn laplacian_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
     let delta = deltas(mesh, v);
     let scale = 1.0 / mesh.num_connected as f64;
     if let Some(grad) = grad {

@@ -10,7 +10,7 @@
 
 use burn::tensor::Tensor;
 
-use super::mesh_loss::{HostMesh, add, sum_over_elements, vertex};
+use super::mesh_loss::{HostMesh, HostTerm, add, sum_over_elements, vertex};
 use super::regularisers::MeshRegularisers;
 use super::rows::{EPS, dot, length};
 use crate::AvatarError;
@@ -19,7 +19,7 @@ impl MeshRegularisers {
     /// Mean over face pairs sharing an edge of `1 − cos(n₁, n₂)`, as `[1]`; 0 when no edge is
     /// shared.
     pub fn normal_consistency(&self, vertices: Tensor<2>) -> Result<Tensor<1>, AvatarError> {
-        self.fused_or(normal_consistency_host, vertices, |v| self.normal_consistency_tensors(v))
+        self.fused_or(HostTerm::NormalConsistency, vertices, |v| self.normal_consistency_tensors(v))
     }
 
     /// [`Self::normal_consistency`] composed from tensor ops.
@@ -43,7 +43,7 @@ impl MeshRegularisers {
 /// The loss on the host. Here the normals are formed (`n₁ = e × u`, `n₂ = w × e`, in f64), and
 /// `∂cos/∂n₁ = n₂/(|n₁||n₂|) − cos·n₁/|n₁|²` (likewise for `n₂`) is taken back through the cross
 /// products: `∂(n₁·g)/∂e = u × g`, `∂(n₁·g)/∂u = g × e`, `∂(n₂·g)/∂w = e × g`, `∂(n₂·g)/∂e = g × w`.
-fn normal_consistency_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
+pub(super) fn normal_consistency_host(mesh: &HostMesh, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
     let h = mesh.hinges.len();
     if h == 0 {
         if let Some(g) = grad {

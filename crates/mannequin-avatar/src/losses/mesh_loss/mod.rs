@@ -1,11 +1,15 @@
-//! The mesh regularisers as one differentiable op with a hand-written backward on Flex (CPU):
-//! composed from tensor ops each costs tens of gathers, scatters and row-wise products each way
-//! (together a tenth of a CPU training step); here each is one pass over its elements. The math
-//! of each term sits next to its tensor form ([`super::laplacian`], [`super::normal_consistency`],
-//! [`super::equilateral`]); this module carries the plumbing.
+//! The mesh regularisers as one differentiable op with a hand-written backward (Flex and
+//! CubeCL): composed from tensor ops each costs tens of gathers, scatters and row-wise products
+//! each way (together a tenth of a CPU training step); here each is one pass over its elements.
+//! The host math of each term sits next to its tensor form ([`super::laplacian`],
+//! [`super::normal_consistency`], [`super::equilateral`]), its GPU form in `kernels.rs`; this
+//! module carries the plumbing.
 
 mod autodiff;
+mod cube;
 mod flex;
+mod kernels;
+mod tables;
 
 use std::sync::Arc;
 
@@ -27,9 +31,13 @@ pub struct HostMesh {
     pub num_connected: usize,
 }
 
-/// A regulariser on the host: its loss at vertices `v` (`[V·3]`, f64), and its gradient when
-/// `grad` is given (overwritten).
-pub type HostTerm = fn(&HostMesh, &[f64], Option<&mut [f64]>) -> f64;
+/// Which regulariser a [`MeshLoss`] evaluates: each backend runs its own form of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HostTerm {
+    Laplacian,
+    NormalConsistency,
+    Equilateral,
+}
 
 /// One regulariser on one mesh.
 #[derive(Clone, Debug)]
@@ -42,12 +50,17 @@ impl MeshLoss {
     /// The loss at vertices `v` (`[V·3]`, f64), and its gradient when `grad` is given
     /// (overwritten).
     pub fn evaluate(&self, v: &[f64], grad: Option<&mut [f64]>) -> f64 {
-        (self.term)(&self.mesh, v, grad)
+        let term = match self.term {
+            HostTerm::Laplacian => super::laplacian::laplacian_host,
+            HostTerm::NormalConsistency => super::normal_consistency::normal_consistency_host,
+            HostTerm::Equilateral => super::equilateral::equilateral_host,
+        };
+        term(&self.mesh, v, grad)
     }
 }
 
 /// Backends that run the fused regularisers.
-#[backend_extension(Flex, Autodiff)]
+#[backend_extension(Flex, Cube, Autodiff)]
 pub trait MeshLossBackend: Backend {
     /// The loss `[1]` of vertices `[V, 3]`.
     fn mesh_loss_forward(vertices: FloatTensor<Self>, loss: MeshLoss) -> FloatTensor<Self>;
@@ -60,9 +73,9 @@ pub trait MeshLossBackend: Backend {
     ) -> FloatTensor<Self>;
 }
 
-/// The loss of vertices `[V, 3]` (f32 or f64) on a [`crate::host_ops::supported`] device,
-/// differentiable with respect to them.
-pub(super) fn mesh_loss(vertices: Tensor<2>, loss: MeshLoss) -> Tensor<1> {
+/// The loss of vertices `[V, 3]` (f32 or f64) on a Flex or wgpu device, differentiable with
+/// respect to them.
+pub fn mesh_loss(vertices: Tensor<2>, loss: MeshLoss) -> Tensor<1> {
     Tensor::from_dispatch(<Dispatch as MeshLossBackend>::mesh_loss_forward(vertices.into_dispatch(), loss))
 }
 
