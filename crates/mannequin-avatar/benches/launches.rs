@@ -103,7 +103,6 @@ fn main() {
         train_frames: 5,
         view_poses: 1,
         motion_frames: 1,
-        ..SynthOptions::default()
     };
     generate(&model, &data, &options, &|| {}).expect("synth");
     let dataset = Dataset::open(&data, 1).expect("dataset");

@@ -5,6 +5,9 @@
 //! the skinning transform's translation At = Gt − G·J_rest (3); the skinning transform's
 //! rotation is G.
 
+// Kernels index their buffers: iterator forms do not exist in CubeCL.
+#![allow(clippy::needless_range_loop)]
+
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 

@@ -2,6 +2,9 @@
 //! of the loss (summed by one reduction after), the backward adds the L1 and mask terms' signs
 //! to the SSIM's gradient. `sign(0) = 0`, as Burn's |x| differentiates.
 
+// Kernels index their buffers: iterator forms do not exist in CubeCL.
+#![allow(clippy::needless_range_loop)]
+
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
