@@ -1,5 +1,6 @@
 //! A stable sort of `(key, value)` pairs of `u32`s on the device: least-significant-digit radix
-//! sort, 4 bits a pass. Stability is what makes the tile lists come out exactly as the CPU
+//! sort, 8 bits a pass (four passes for a depth key: each pass is three to five launches, and
+//! launches, not bandwidth, are what a training step's sorts cost). Stability is what makes the tile lists come out exactly as the CPU
 //! binning's: equal keys keep their input order (ties by Gaussian index, then by depth rank).
 //!
 //! Each unit owns a run of `CHUNK` consecutive pairs. A pass counts the digits of every run, lays
@@ -15,7 +16,7 @@ use super::device_buffers::{buffer, u32_of, units_dim, units_grid};
 use super::scan::exclusive_scan;
 
 /// Bits sorted per pass, and the digit values.
-const DIGIT_BITS: u32 = 4;
+const DIGIT_BITS: u32 = 8;
 const DIGITS: usize = 1 << DIGIT_BITS;
 
 /// Pairs one unit owns.

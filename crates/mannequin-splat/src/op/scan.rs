@@ -11,8 +11,8 @@ use cubecl::prelude::*;
 
 use super::device_buffers::{buffer, u32_of, units_dim, units_grid, zeros};
 
-/// Values one unit scans.
-const CHUNK: u32 = 64;
+/// Values one unit scans: long enough that a radix pass's counts take two or three levels.
+const CHUNK: u32 = 256;
 
 /// `totals[u]` is the sum of chunk `u`.
 #[cube(launch)]
@@ -88,7 +88,7 @@ mod tests {
     #[test]
     fn exclusive_scan_matches_a_running_sum() {
         let device = device();
-        for len in [1, 63, 64, 65, 4096, 4097, 70_001] {
+        for len in [1, 255, 256, 257, 65_536, 65_537, 70_001] {
             let values: Vec<u32> = (0..len as u32).map(|i| (i * 7919) % 13).collect();
             let t = words(&values, &device);
             exclusive_scan(&t, len);
