@@ -11,7 +11,7 @@ use burn_cubecl::cubecl;
 use burn_cubecl::kernel::into_contiguous;
 use cubecl::prelude::*;
 
-use super::kernels::{ssim_coefficients, ssim_combine, ssim_map};
+use super::kernels::{moment_planes, ssim_coefficients, ssim_combine, ssim_map};
 use super::{C1, C2, SsimBackend};
 use crate::losses::blur::{TAPS, as_f32, blur_f32};
 
@@ -36,15 +36,17 @@ impl SsimBackend for CubeBackend {
         let [c, h, w]: [usize; 3] = x.shape().to_vec().try_into().expect("SSIM inputs are [C, H, W]");
         let (x, back) = as_f32(x);
         let (y, _) = as_f32(y);
-        let planes = B::float_cat(
-            vec![
-                x.clone(),
-                y.clone(),
-                B::float_mul(x.clone(), x.clone()),
-                B::float_mul(y.clone(), y.clone()),
-                B::float_mul(x, y),
-            ],
-            0,
+        let size = c * h * w;
+        let planes = empty(vec![5 * c, h, w], &x);
+        let (count, dim) = grid(&x, size);
+        moment_planes::launch(
+            &x.client,
+            count,
+            dim,
+            x.clone().into_buffer_arg(),
+            y.into_buffer_arg(),
+            planes.clone().into_buffer_arg(),
+            u32_of(size),
         );
         let moments = blur_f32(planes, 0);
         let (oh, ow) = (h + 1 - TAPS, w + 1 - TAPS);

@@ -19,6 +19,22 @@ fn factors(moments: &[f32], plane: usize, i: usize, c1: f32, c2: f32) -> (f32, f
     (2.0 * mxy + c1, 2.0 * (exy - mxy) + c2, (mx2 + my2) + c1, (exx - mx2) + (eyy - my2) + c2)
 }
 
+/// `planes` `[5, size]`: x, y, x², y², xy, the images the moments are blurred from.
+#[cube(launch)]
+pub(crate) fn moment_planes(x: &[f32], y: &[f32], planes: &mut [f32], size: u32) {
+    let i = ABSOLUTE_POS;
+    let n = size as usize;
+    if i >= n {
+        terminate!();
+    }
+    let (a, b) = (x[i], y[i]);
+    planes[i] = a;
+    planes[n + i] = b;
+    planes[2 * n + i] = a * a;
+    planes[3 * n + i] = b * b;
+    planes[4 * n + i] = a * b;
+}
+
 #[cube(launch)]
 pub(crate) fn ssim_map(moments: &[f32], map: &mut [f32], plane: u32, c1: f32, c2: f32) {
     let i = ABSOLUTE_POS;
