@@ -8,12 +8,13 @@ use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
+use burn::tensor::FloatDType;
 
 use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
 use burn_cubecl::kernel::into_contiguous;
 
 use super::binning::bin;
-use super::device_buffers::{read, u32_of, units_dim, units_grid, upload, zeros};
+use super::device_buffers::{buffer, read, u32_of, units_dim, units_grid, upload, zeros};
 use super::kernels::{LayoutLaunch, composite_backward, composite_forward};
 use super::project_kernels::{camera_words, project_backward, project_forward};
 use super::saved::{HEADER, WordLayout, size_words};
@@ -66,8 +67,9 @@ pub(super) fn project(inputs: [CubeTensor; 5], config: &SplatConfig) -> Projecte
     let like = means.clone();
     let n = means.shape()[0];
     let stride = field::COLOR + config.channels();
+    // Rows of skipped Gaussians stay zero; every radius is written.
     let rows = zeros(vec![n * stride], &like);
-    let radii = zeros(vec![2 * n], &like);
+    let radii = buffer(2 * n, &like);
     let skipped = zeros(vec![1], &like);
     if n > 0 {
         project_forward::launch(
@@ -117,8 +119,9 @@ impl SplatBackend for CubeBackend {
         parts.extend(tiles.ids);
         parts.push(p.rows);
         let words = Self::float_cat(parts, 0);
-        let rendered = zeros(vec![c + 2, h, w], &like);
-        let last = zeros(vec![w * h], &like);
+        // The compositing writes every pixel of both.
+        let rendered = Self::float_empty([c + 2, h, w].into(), &like.device, FloatDType::F32);
+        let last = buffer(w * h, &like);
         composite_forward::launch(
             &like.client,
             tile_grid(&config),
