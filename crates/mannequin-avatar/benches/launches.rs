@@ -60,16 +60,17 @@ impl Tally {
         // CubeCL creates the log at its first line.
         let Ok(mut file) = std::fs::File::open(&self.log) else { return };
         file.seek(SeekFrom::Start(self.offset)).expect("seek");
-        let mut text = String::new();
-        file.read_to_string(&mut text).expect("read");
-        // Only whole lines; a partial one waits for the next look.
-        let whole = text.rfind('\n').map_or(0, |i| i + 1);
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).expect("read");
+        // Only whole lines; a partial one (perhaps cut inside a character) waits for the next look.
+        let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
         self.offset += whole as u64;
         if !self.counting {
             return;
         }
+        let text = String::from_utf8_lossy(&bytes[..whole]);
         let by_kernel = self.launches.entry(phase_name(phase)).or_default();
-        for name in text[..whole].lines().filter_map(kernel) {
+        for name in text.lines().filter_map(kernel) {
             *by_kernel.entry(name.to_string()).or_default() += 1;
         }
     }

@@ -19,8 +19,9 @@ use super::scan::exclusive_scan;
 const DIGIT_BITS: u32 = 8;
 const DIGITS: usize = 1 << DIGIT_BITS;
 
-/// Pairs one unit owns.
-const CHUNK: u32 = 64;
+/// Pairs one unit owns: as many as digit values, so a pass's counts are about as many as its
+/// pairs and their scan takes two levels.
+const CHUNK: u32 = 256;
 
 #[cube(launch)]
 fn digit_counts(keys: &[u32], counts: &mut [u32], len: u32, shift: u32, units: u32) {
