@@ -1,0 +1,136 @@
+//! The MLP on the CubeCL backends. The forward pass is one launch. The backward pass is one
+//! per-row launch (recomputing the activations, as on Flex) and then, per layer, the weight
+//! gradient as one matmul of the transposed activations by the layer's gradients and the bias
+//! gradient as one sum over rows: seven launches, gathers only, nothing read back. Works in f32;
+//! other float types are converted on the way in and out.
+
+use burn::backend::TensorMetadata;
+use burn::backend::ops::FloatTensorOps;
+use burn::backend::tensor::FloatTensor;
+use burn::backend::wgpu::{CubeBackend, CubeTensor};
+use burn::tensor::FloatDType;
+use burn_cubecl::cubecl;
+use cubecl::prelude::*;
+
+use super::MlpBackend;
+use super::kernels::{mlp_backward_rows, mlp_forward};
+use crate::losses::blur::as_f32;
+
+type B = CubeBackend;
+
+fn u32_of(v: usize) -> u32 {
+    u32::try_from(v).expect("MLP rows index within u32")
+}
+
+fn empty(shape: [usize; 2], like: &CubeTensor) -> CubeTensor {
+    B::float_empty(shape.into(), &like.device, FloatDType::F32)
+}
+
+/// Launch geometry for one unit per row.
+fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
+    let dim = CubeDim::new_1d(256);
+    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
+}
+
+/// The rows `N` and widths `[I, H, O]` of `x` `[N, I]`, `w0` `[I, H]` and `w2` `[H, O]`.
+fn sizes(x: &CubeTensor, w0: &CubeTensor, w2: &CubeTensor) -> (usize, [usize; 3]) {
+    let (x, w0, w2) = (x.shape(), w0.shape(), w2.shape());
+    (x[0], [x[1], w0[1], w2[1]])
+}
+
+impl MlpBackend for CubeBackend {
+    fn mlp_forward(
+        x: FloatTensor<Self>,
+        w0: FloatTensor<Self>,
+        b0: FloatTensor<Self>,
+        w1: FloatTensor<Self>,
+        b1: FloatTensor<Self>,
+        w2: FloatTensor<Self>,
+        b2: FloatTensor<Self>,
+    ) -> FloatTensor<Self> {
+        let (n, [i, h, o]) = sizes(&x, &w0, &w2);
+        let (x, back) = as_f32(x);
+        let [w0, b0, w1, b1, w2, b2] = [w0, b0, w1, b1, w2, b2].map(|t| as_f32(t).0);
+        let out = empty([n, o], &x);
+        let (h1t, h2t) = (empty([h, n], &x), empty([h, n], &x));
+        let (count, dim) = grid(&x, n);
+        mlp_forward::launch(
+            &x.client,
+            count,
+            dim,
+            x.clone().into_buffer_arg(),
+            w0.into_buffer_arg(),
+            b0.into_buffer_arg(),
+            w1.into_buffer_arg(),
+            b1.into_buffer_arg(),
+            w2.into_buffer_arg(),
+            b2.into_buffer_arg(),
+            h1t.into_buffer_arg(),
+            h2t.into_buffer_arg(),
+            out.clone().into_buffer_arg(),
+            u32_of(n),
+            i,
+            h,
+            o,
+        );
+        back(out)
+    }
+
+    fn mlp_backward(
+        x: FloatTensor<Self>,
+        w0: FloatTensor<Self>,
+        b0: FloatTensor<Self>,
+        w1: FloatTensor<Self>,
+        b1: FloatTensor<Self>,
+        w2: FloatTensor<Self>,
+        b2: FloatTensor<Self>,
+        grad: FloatTensor<Self>,
+    ) -> (
+        FloatTensor<Self>,
+        FloatTensor<Self>,
+        FloatTensor<Self>,
+        FloatTensor<Self>,
+        FloatTensor<Self>,
+        FloatTensor<Self>,
+        FloatTensor<Self>,
+    ) {
+        let (n, [i, h, o]) = sizes(&x, &w0, &w2);
+        let (x, back) = as_f32(x);
+        let (grad, _) = as_f32(grad);
+        let [w0, b0, w1, b1, w2, _] = [w0, b0, w1, b1, w2, b2].map(|t| as_f32(t).0);
+        let dx = empty([n, i], &x);
+        let (g0, g1) = (empty([n, h], &x), empty([n, h], &x));
+        let (h1t, h2t) = (empty([h, n], &x), empty([h, n], &x));
+        let (count, dim) = grid(&x, n);
+        mlp_backward_rows::launch(
+            &x.client,
+            count,
+            dim,
+            x.clone().into_buffer_arg(),
+            w0.into_buffer_arg(),
+            b0.into_buffer_arg(),
+            w1.into_buffer_arg(),
+            b1.into_buffer_arg(),
+            w2.into_buffer_arg(),
+            grad.clone().into_buffer_arg(),
+            dx.clone().into_buffer_arg(),
+            g0.clone().into_buffer_arg(),
+            g1.clone().into_buffer_arg(),
+            h1t.clone().into_buffer_arg(),
+            h2t.clone().into_buffer_arg(),
+            u32_of(n),
+            i,
+            h,
+            o,
+        );
+        // Layer `l`'s weight gradient is (its input)ᵀ·(its gradient), its bias gradient the sum
+        // of its gradient over rows.
+        let layer = |input_t: CubeTensor, g: CubeTensor| {
+            (back(B::float_matmul(input_t, g.clone())), back(B::float_sum_dim(g, 0)))
+        };
+        let (dw0, db0) = layer(B::float_swap_dims(x, 0, 1), g0);
+        let (dw1, db1) = layer(h1t, g1);
+        let (dw2, db2) = layer(h2t, grad);
+        (back(dx), dw0, db0, dw1, db1, dw2, db2)
+    }
+}
