@@ -59,7 +59,7 @@ impl Mlp {
     }
 
     pub fn forward(&self, params: &[Param], x: Tensor<2>) -> Tensor<2> {
-        if crate::host_ops::on_flex(&x.device()) && fused_mlp::supports(&self.widths(params)) {
+        if crate::host_ops::supported(&x.device()) && fused_mlp::supports(&self.widths(params)) {
             let [w0, w1, w2] = [0, 1, 2].map(|l| params[self.layers[l].0].value.clone());
             let [b0, b1, b2] = [0, 1, 2].map(|l| params[self.layers[l].1].value.clone());
             return fused_mlp::mlp(x, [w0, w1, w2], [b0, b1, b2]);
