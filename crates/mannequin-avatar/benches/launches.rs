@@ -8,7 +8,10 @@
 //! each phase with its most frequent kernels, the total against the target (100), and the
 //! per-phase times (meaningful on a real GPU only).
 //!
-//! `cargo bench -p mannequin-avatar --bench launches -- [--iters N] [--warmup N] [--size PX] [--seed S]`
+//! `--top K` lists K kernels a phase (default 5); the kernels that take the most device time
+//! (as the profiler times each one alone) follow.
+//!
+//! `cargo bench -p mannequin-avatar --bench launches -- [--iters N] [--warmup N] [--size PX] [--seed S] [--top K]`
 
 use std::collections::BTreeMap;
 use std::io::{Read, Seek, SeekFrom};
@@ -36,22 +39,30 @@ struct Tally {
     offset: u64,
     counting: bool,
     launches: BTreeMap<String, BTreeMap<String, usize>>,
+    /// Device seconds by kernel, over every phase.
+    seconds: BTreeMap<String, f64>,
 }
 
 fn phase_name(phase: Option<Phase>) -> String {
     phase.map_or_else(|| "before the first phase".into(), |p| format!("{p:?}").to_lowercase())
 }
 
-/// The kernel of a profile line `| 1.2ms | Name | …`, or `None` for any other line.
-fn kernel(line: &str) -> Option<&str> {
+/// The kernel and the seconds of a profile line `| 1.2ms | Name | …`, or `None` for any other
+/// line.
+fn kernel(line: &str) -> Option<(&str, f64)> {
     let mut cells = line.strip_prefix('|')?.split('|').map(str::trim);
     let time = cells.next()?;
-    let unit = time.trim_start_matches(|c: char| c.is_ascii_digit() || c == '.');
-    if unit.len() == time.len() || !matches!(unit, "ns" | "µs" | "ms" | "s") {
-        return None;
-    }
+    let digits = time.trim_end_matches(|c: char| !(c.is_ascii_digit() || c == '.'));
+    let scale = match &time[digits.len()..] {
+        "ns" => 1e-9,
+        "µs" => 1e-6,
+        "ms" => 1e-3,
+        "s" => 1.0,
+        _ => return None,
+    };
+    let seconds = digits.parse::<f64>().ok()? * scale;
     let name = cells.next()?;
-    Some(name.split_once('_').map_or(name, |(head, _)| head))
+    Some((name.split_once('_').map_or(name, |(head, _)| head), seconds))
 }
 
 impl Tally {
@@ -70,8 +81,9 @@ impl Tally {
         }
         let text = String::from_utf8_lossy(&bytes[..whole]);
         let by_kernel = self.launches.entry(phase_name(phase)).or_default();
-        for name in text.lines().filter_map(kernel) {
+        for (name, seconds) in text.lines().filter_map(kernel) {
             *by_kernel.entry(name.to_string()).or_default() += 1;
+            *self.seconds.entry(name.to_string()).or_default() += seconds;
         }
     }
 }
@@ -85,6 +97,7 @@ fn main() {
     let warmup: usize = arg("--warmup", 3);
     let size: usize = arg("--size", 128);
     let seed: u64 = arg("--seed", 0);
+    let top_kernels: usize = arg("--top", 5);
     let dir = std::env::temp_dir().join(format!("mannequin-launches-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("bench folder");
     let log = dir.join("cubecl.log");
@@ -123,7 +136,13 @@ fn main() {
     };
     let mut trainer = Trainer::new(avatar, views, train).expect("trainer");
 
-    let tally = Arc::new(Mutex::new(Tally { log, offset: 0, counting: false, launches: BTreeMap::new() }));
+    let tally = Arc::new(Mutex::new(Tally {
+        log,
+        offset: 0,
+        counting: false,
+        launches: BTreeMap::new(),
+        seconds: BTreeMap::new(),
+    }));
     let hook = tally.clone();
     trainer.on_phase = Some(Box::new(move |phase| hook.lock().expect("tally").charge(phase)));
     trainer.profile = true;
@@ -166,7 +185,7 @@ fn main() {
         let mut top: Vec<_> = by_kernel.into_iter().collect();
         top.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
         let top: Vec<String> =
-            top.iter().take(5).map(|(name, c)| format!("{name} {:.1}", *c as f64 / n)).collect();
+            top.iter().take(top_kernels).map(|(name, c)| format!("{name} {:.1}", *c as f64 / n)).collect();
         let time = k.checked_sub(1).map_or(String::from("-"), |i| format!("{:.2}", ms(times[i]) / n));
         println!("{:<24} {count:>9.1} {time:>9}   {}", phase_name(phase), top.join(", "));
     }
@@ -175,5 +194,14 @@ fn main() {
         total / TARGET,
         if total <= TARGET { "met" } else { "NOT met" }
     );
+    let mut by_time: Vec<_> = tally.seconds.iter().collect();
+    by_time.sort_by(|a, b| b.1.total_cmp(a.1).then(a.0.cmp(b.0)));
+    let device_ms: f64 = tally.seconds.values().sum::<f64>() * 1e3 / n;
+    println!(
+        "device time per iteration, as CubeCL's profiler times each kernel: {device_ms:.2} ms; longest:"
+    );
+    for (name, seconds) in by_time.iter().take(top_kernels.max(12)) {
+        println!("  {name:<28} {:>8.3} ms", *seconds * 1e3 / n);
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
