@@ -38,6 +38,7 @@ pub mod settings;
 pub mod sh_colour;
 pub mod skirt_layer;
 pub mod subject_mesh;
+mod tall_product;
 pub mod test_pose_fit;
 pub mod trainer;
 pub mod training;

@@ -1,7 +1,8 @@
 //! The MLP on the CubeCL backends. The forward pass is one launch. The backward pass is one
 //! per-row launch (recomputing the activations, as on Flex) and then, per layer, the weight
-//! gradient as one matmul of the transposed activations by the layer's gradients and the bias
-//! gradient as one sum over rows: seven launches, gathers only, nothing read back. Works in f32;
+//! gradient as a product of the transposed activations by the layer's gradients and the bias
+//! gradient as a sum over rows, each two launches ([`crate::tall_product`]): thirteen launches,
+//! gathers only, nothing read back. Works in f32;
 //! other float types are converted on the way in and out.
 
 use burn::backend::TensorMetadata;
@@ -15,6 +16,7 @@ use cubecl::prelude::*;
 use super::MlpBackend;
 use super::kernels::{mlp_backward_rows, mlp_forward};
 use crate::losses::blur::as_f32;
+use crate::tall_product::{Left, tall_product};
 
 type B = CubeBackend;
 
@@ -124,13 +126,14 @@ impl MlpBackend for CubeBackend {
             o,
         );
         // Layer `l`'s weight gradient is (its input)ᵀ·(its gradient), its bias gradient the sum
-        // of its gradient over rows.
-        let layer = |input_t: CubeTensor, g: CubeTensor| {
-            (back(B::float_matmul(input_t, g.clone())), back(B::float_sum_dim(g, 0)))
+        // of its gradient over rows: products over the N rows into small outputs.
+        let layer = |input: Left, g: CubeTensor, width: usize| {
+            (back(tall_product(input, &g, n, width)), back(tall_product(Left::Ones, &g, n, width)))
         };
-        let (dw0, db0) = layer(B::float_swap_dims(x, 0, 1), g0);
-        let (dw1, db1) = layer(h1t, g1);
-        let (dw2, db2) = layer(h2t, grad);
+        let rows = Left::Strided { a: x, columns: i, stride_k: i, stride_m: 1 };
+        let (dw0, db0) = layer(rows, g0, h);
+        let (dw1, db1) = layer(Left::Strided { a: h1t, columns: h, stride_k: 1, stride_m: n }, g1, h);
+        let (dw2, db2) = layer(Left::Strided { a: h2t, columns: h, stride_k: 1, stride_m: n }, grad, o);
         (back(dx), dw0, db0, dw1, db1, dw2, db2)
     }
 }

@@ -1,6 +1,6 @@
 //! The op on the CubeCL backends: the chain in one unit, the vertices one unit each, and the
-//! backward's two reductions over vertices as matrix products (the blend matrix's row of ones
-//! sums the translation's gradient in the same product).
+//! backward's two reductions over vertices as products over vertices ([`crate::tall_product`];
+//! the blend matrix's row of ones sums the translation's gradient in the same product).
 
 use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
@@ -13,6 +13,7 @@ use cubecl::prelude::*;
 
 use super::SkinningBackend;
 use super::kernels::{CHAIN, chain_backward, chain_forward, skin_vertices, skin_vertices_backward};
+use crate::tall_product::{Left, tall_product};
 
 type B = CubeBackend;
 
@@ -121,10 +122,12 @@ impl SkinningBackend for CubeBackend {
             u32_of(features),
         );
         // Σ_v w_vj·outer_v for every joint, and Σ_v g_v in the row of ones.
-        let d_transforms = B::float_matmul(blend, outer);
+        let weights = Left::Strided { a: blend, columns: count + 1, stride_k: 1, stride_m: n };
+        let d_transforms = tall_product(weights, &outer, n, 12);
         // The correctives' features: posedirs · v_P's gradient (which is the rest vertices').
         let d_features = if features > 0 {
-            B::float_matmul(posedirs, B::float_reshape(d_vertices.clone(), [3 * n, 1].into()))
+            let correctives = Left::Strided { a: posedirs, columns: features, stride_k: 1, stride_m: 3 * n };
+            tall_product(correctives, &d_vertices, 3 * n, 1)
         } else {
             empty(vec![1, 1], &vertices)
         };
