@@ -11,6 +11,7 @@ pub mod checkpoint;
 pub mod colour_init;
 pub mod compute;
 pub mod config;
+mod cube_launch;
 pub mod error;
 pub mod evaluation;
 pub mod export;

@@ -8,22 +8,17 @@ use std::sync::{Arc, Mutex, PoisonError, Weak};
 use burn::backend::ops::{FloatTensorOps, IntTensorOps};
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
-use burn::tensor::{FloatDType, IntDType, TensorData};
+use burn::tensor::{IntDType, TensorData};
 use burn_cubecl::CubeDevice;
-use burn_cubecl::cubecl;
-use cubecl::prelude::*;
 
 use super::kernels::{ParamsLaunch, bind_faces, bind_vertices, face_terms, gather_vertices, vertex_terms};
 use super::{BindConfig, BindingBackend, PACKED, plane_starts};
+use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
 use crate::mesh_gaussians::{FACE_SCALE, NORM_EPS, NORMAL_SCALE, VERTEX_SCALE};
 use crate::one_ring_mesh::OneRingMesh;
 
 type B = CubeBackend;
-
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("binding sizes index within u32")
-}
 
 /// A mesh's index tables on one device, laid out as `kernels.rs` reads them.
 #[derive(Clone)]
@@ -107,24 +102,14 @@ fn params(config: &BindConfig) -> ParamsLaunch {
     )
 }
 
-/// Launch geometry for one unit per element.
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
-
-fn empty_f32(n: usize, like: &CubeTensor) -> CubeTensor {
-    B::float_empty([n].into(), &like.device, FloatDType::F32)
-}
-
 impl BindingBackend for CubeBackend {
     fn tavatar_bind_forward(vertices: FloatTensor<Self>, config: BindConfig) -> FloatTensor<Self> {
         let (v, back) = as_f32(vertices);
         let t = Tables::of(&config.mesh, &v.device);
-        let out = empty_f32(config.num_gaussians() * PACKED, &v);
+        let out = empty_f32(vec![config.num_gaussians() * PACKED], &v);
         let client = &v.client;
         if config.face_gaussians {
-            let (count, dim) = grid(&v, config.mesh.faces.len());
+            let (count, dim) = per_element(&v, config.mesh.faces.len());
             bind_faces::launch(
                 client,
                 count,
@@ -136,7 +121,7 @@ impl BindingBackend for CubeBackend {
             );
         }
         if config.vertex_gaussians {
-            let (count, dim) = grid(&v, config.mesh.num_vertices);
+            let (count, dim) = per_element(&v, config.mesh.num_vertices);
             bind_vertices::launch(
                 client,
                 count,
@@ -165,10 +150,10 @@ impl BindingBackend for CubeBackend {
         let (nf, nv) = (config.mesh.faces.len(), config.mesh.num_vertices);
         let client = &v.client;
         // Read only with vertex Gaussians.
-        let terms = empty_f32(6 * nv, &v);
+        let terms = empty_f32(vec![6 * nv], &v);
         let nearest = B::int_empty([nv].into(), &v.device, IntDType::U32);
         if config.vertex_gaussians {
-            let (count, dim) = grid(&v, nv);
+            let (count, dim) = per_element(&v, nv);
             vertex_terms::launch(
                 client,
                 count,
@@ -185,8 +170,8 @@ impl BindingBackend for CubeBackend {
                 params(&config),
             );
         }
-        let corner_grads = empty_f32(9 * nf, &v);
-        let (count, dim) = grid(&v, nf);
+        let corner_grads = empty_f32(vec![9 * nf], &v);
+        let (count, dim) = per_element(&v, nf);
         face_terms::launch(
             client,
             count,
@@ -200,8 +185,8 @@ impl BindingBackend for CubeBackend {
             config.face_gaussians,
             config.vertex_gaussians,
         );
-        let d = empty_f32(3 * nv, &v);
-        let (count, dim) = grid(&v, nv);
+        let d = empty_f32(vec![3 * nv], &v);
+        let (count, dim) = per_element(&v, nv);
         gather_vertices::launch(
             client,
             count,

@@ -6,33 +6,14 @@
 //! other float types are converted on the way in and out.
 
 use burn::backend::TensorMetadata;
-use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
-use burn::tensor::FloatDType;
-use burn_cubecl::cubecl;
-use cubecl::prelude::*;
 
 use super::MlpBackend;
 use super::kernels::{mlp_backward_rows, mlp_forward};
+use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
 use crate::tall_product::{Left, tall_product};
-
-type B = CubeBackend;
-
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("MLP rows index within u32")
-}
-
-fn empty(shape: [usize; 2], like: &CubeTensor) -> CubeTensor {
-    B::float_empty(shape.into(), &like.device, FloatDType::F32)
-}
-
-/// Launch geometry for one unit per row.
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
 
 /// The rows `N` and widths `[I, H, O]` of `x` `[N, I]`, `w0` `[I, H]` and `w2` `[H, O]`.
 fn sizes(x: &CubeTensor, w0: &CubeTensor, w2: &CubeTensor) -> (usize, [usize; 3]) {
@@ -53,9 +34,9 @@ impl MlpBackend for CubeBackend {
         let (n, [i, h, o]) = sizes(&x, &w0, &w2);
         let (x, back) = as_f32(x);
         let [w0, b0, w1, b1, w2, b2] = [w0, b0, w1, b1, w2, b2].map(|t| as_f32(t).0);
-        let out = empty([n, o], &x);
-        let (h1t, h2t) = (empty([h, n], &x), empty([h, n], &x));
-        let (count, dim) = grid(&x, n);
+        let out = empty_f32(vec![n, o], &x);
+        let (h1t, h2t) = (empty_f32(vec![h, n], &x), empty_f32(vec![h, n], &x));
+        let (count, dim) = per_element(&x, n);
         mlp_forward::launch(
             &x.client,
             count,
@@ -100,10 +81,10 @@ impl MlpBackend for CubeBackend {
         let (x, back) = as_f32(x);
         let (grad, _) = as_f32(grad);
         let [w0, b0, w1, b1, w2, _] = [w0, b0, w1, b1, w2, b2].map(|t| as_f32(t).0);
-        let dx = empty([n, i], &x);
-        let (g0, g1) = (empty([n, h], &x), empty([n, h], &x));
-        let (h1t, h2t) = (empty([h, n], &x), empty([h, n], &x));
-        let (count, dim) = grid(&x, n);
+        let dx = empty_f32(vec![n, i], &x);
+        let (g0, g1) = (empty_f32(vec![n, h], &x), empty_f32(vec![n, h], &x));
+        let (h1t, h2t) = (empty_f32(vec![h, n], &x), empty_f32(vec![h, n], &x));
+        let (count, dim) = per_element(&x, n);
         mlp_backward_rows::launch(
             &x.client,
             count,

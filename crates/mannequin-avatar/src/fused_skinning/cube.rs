@@ -3,45 +3,26 @@
 //! the blend matrix's row of ones sums the translation's gradient in the same product).
 
 use burn::backend::TensorMetadata;
-use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::{FloatTensor, IntTensor};
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
-use burn::tensor::FloatDType;
 use burn_cubecl::cubecl;
 use burn_cubecl::kernel::into_contiguous;
 use cubecl::prelude::*;
 
 use super::SkinningBackend;
 use super::kernels::{CHAIN, chain_backward, chain_forward, skin_vertices, skin_vertices_backward};
+use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::tall_product::{Left, tall_product};
-
-type B = CubeBackend;
-
-/// Units per cube of the per-vertex kernels.
-const GROUP: u32 = 256;
-
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("skinning sizes index within u32")
-}
-
-fn empty(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
-    B::float_empty(shape.into(), &like.device, FloatDType::F32)
-}
 
 /// One unit, for the chain's sequential passes.
 fn single() -> (CubeCount, CubeDim) {
     (CubeCount::Static(1, 1, 1), CubeDim::new_1d(1))
 }
 
-fn per_vertex(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(GROUP);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
-
 /// The chain's record `[J, CHAIN]` of `pose` and `joints`.
 fn chain(pose: &CubeTensor, joints: &CubeTensor, parents: &CubeTensor) -> CubeTensor {
     let count = joints.shape()[0];
-    let record = empty(vec![count, CHAIN], joints);
+    let record = empty_f32(vec![count, CHAIN], joints);
     let (cubes, dim) = single();
     chain_forward::launch(
         &joints.client,
@@ -71,8 +52,8 @@ impl SkinningBackend for CubeBackend {
             [vertices, joints, pose, transl, blend, posedirs, parents].map(into_contiguous);
         let (n, count) = (vertices.shape()[0], joints.shape()[0]);
         let record = chain(&pose, &joints, &parents);
-        let posed = empty(vec![n, 3], &vertices);
-        let (cubes, dim) = per_vertex(&vertices, n);
+        let posed = empty_f32(vec![n, 3], &vertices);
+        let (cubes, dim) = per_element(&vertices, n);
         skin_vertices::launch(
             &vertices.client,
             cubes,
@@ -104,8 +85,8 @@ impl SkinningBackend for CubeBackend {
             [vertices, joints, pose, blend, posedirs, parents, grad].map(into_contiguous);
         let (n, count) = (vertices.shape()[0], joints.shape()[0]);
         let record = chain(&pose, &joints, &parents);
-        let (d_vertices, outer) = (empty(vec![n, 3], &vertices), empty(vec![n, 12], &vertices));
-        let (cubes, dim) = per_vertex(&vertices, n);
+        let (d_vertices, outer) = (empty_f32(vec![n, 3], &vertices), empty_f32(vec![n, 12], &vertices));
+        let (cubes, dim) = per_element(&vertices, n);
         skin_vertices_backward::launch(
             &vertices.client,
             cubes,
@@ -129,13 +110,13 @@ impl SkinningBackend for CubeBackend {
             let correctives = Left::Strided { a: posedirs, columns: features, stride_k: 1, stride_m: 3 * n };
             tall_product(correctives, &d_vertices, 3 * n, 1)
         } else {
-            empty(vec![1, 1], &vertices)
+            empty_f32(vec![1, 1], &vertices)
         };
-        let work = empty(vec![count, 12], &vertices);
+        let work = empty_f32(vec![count, 12], &vertices);
         let (d_pose, d_joints, d_transl) = (
-            empty(vec![1, 3 * count], &vertices),
-            empty(vec![count, 3], &vertices),
-            empty(vec![1, 3], &vertices),
+            empty_f32(vec![1, 3 * count], &vertices),
+            empty_f32(vec![count, 3], &vertices),
+            empty_f32(vec![1, 3], &vertices),
         );
         let (cubes, dim) = single();
         chain_backward::launch(

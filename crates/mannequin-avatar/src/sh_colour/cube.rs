@@ -6,12 +6,11 @@ use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
 use burn::tensor::FloatDType;
-use burn_cubecl::cubecl;
-use cubecl::prelude::*;
 use mannequin_splat::sh::{MAX_DEGREE, basis_len};
 
 use super::kernels::{colour_backward, colour_forward};
 use super::{ColourBackend, ColourConfig};
+use crate::cube_launch::{per_element, u32_of};
 use crate::losses::blur::as_f32;
 
 type B = CubeBackend;
@@ -25,16 +24,6 @@ fn sizes(means: &CubeTensor, coeffs: &CubeTensor, config: &ColourConfig) -> (usi
     (n, degree)
 }
 
-/// Launch geometry for one unit per Gaussian.
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
-
-fn u32_of(n: usize) -> u32 {
-    u32::try_from(n).expect("Gaussian count fits u32")
-}
-
 impl ColourBackend for CubeBackend {
     fn sh_colour_forward(
         means: FloatTensor<Self>,
@@ -45,7 +34,7 @@ impl ColourBackend for CubeBackend {
         let (means, back) = as_f32(means);
         let (coeffs, _) = as_f32(coeffs);
         let out = B::float_empty([n, 3].into(), &means.device, FloatDType::F32);
-        let (count, dim) = grid(&means, n);
+        let (count, dim) = per_element(&means, n);
         let [ex, ey, ez] = config.eye;
         colour_forward::launch(
             &means.client,
@@ -75,7 +64,7 @@ impl ColourBackend for CubeBackend {
         let (grad, _) = as_f32(grad);
         let d_means = B::float_empty([n, 3].into(), &means.device, FloatDType::F32);
         let d_coeffs = B::float_empty(coeffs.shape(), &means.device, FloatDType::F32);
-        let (count, dim) = grid(&means, n);
+        let (count, dim) = per_element(&means, n);
         let [ex, ey, ez] = config.eye;
         colour_backward::launch(
             &means.client,

@@ -10,9 +10,8 @@ mod kernels;
 use burn::backend::ops::FloatTensorOps;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
 use burn::tensor::FloatDType;
-use burn_cubecl::cubecl;
-use cubecl::prelude::*;
 
+use crate::cube_launch::{per_element, u32_of};
 use kernels::{chunk_products, sum_chunks};
 
 /// Rows one unit sums.
@@ -33,15 +32,6 @@ pub(crate) enum Left {
     Ones,
 }
 
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("product sizes index within u32")
-}
-
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
-
 /// `aᵀ·b` `[M, N]` of contiguous f32 `b` `[K, N]` (M = 1 for [`Left::Ones`]).
 pub(crate) fn tall_product(a: Left, b: &CubeTensor, k: usize, n: usize) -> CubeTensor {
     let (ones, a, m, stride_k, stride_m) = match a {
@@ -52,7 +42,7 @@ pub(crate) fn tall_product(a: Left, b: &CubeTensor, k: usize, n: usize) -> CubeT
     let (outputs, chunks) = (m * n, k.div_ceil(CHUNK).max(1));
     let empty = |shape: Vec<usize>| CubeBackend::float_empty(shape.into(), &b.device, FloatDType::F32);
     let (partials, out) = (empty(vec![chunks * outputs]), empty(vec![m, n]));
-    let (count, dim) = grid(b, chunks * outputs);
+    let (count, dim) = per_element(b, chunks * outputs);
     chunk_products::launch(
         &b.client,
         count,
@@ -68,7 +58,7 @@ pub(crate) fn tall_product(a: Left, b: &CubeTensor, k: usize, n: usize) -> CubeT
         u32_of(CHUNK),
         ones,
     );
-    let (count, dim) = grid(b, outputs);
+    let (count, dim) = per_element(b, outputs);
     sum_chunks::launch(
         &b.client,
         count,

@@ -12,6 +12,7 @@ use burn_cubecl::kernel::into_contiguous;
 use cubecl::prelude::*;
 
 use super::{BlurBackend, TAPS, gaussian_window};
+use crate::cube_launch::u32_of;
 
 /// `output[o, t, j] = Σ_k weights[k] · input[o, t + k − padding, j]` over the taps whose source
 /// lies inside `[0, len_in)`. The tap loop is unrolled, so no shader loop is long (kernels
@@ -47,10 +48,6 @@ fn blur_axis(
         }
     }
     output[i] = acc;
-}
-
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("blur sizes index within u32")
 }
 
 /// One pass along the middle axis of `x` viewed as `[outer, len_in, inner]`.

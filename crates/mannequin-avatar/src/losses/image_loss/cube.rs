@@ -4,29 +4,15 @@ use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
-use burn::tensor::{FloatDType, TensorData};
-use burn_cubecl::cubecl;
-use cubecl::prelude::*;
+use burn::tensor::TensorData;
 
 use super::kernels::{loss_shares, map_gradient, pixel_gradients};
 use super::{ImageLossBackend, ImageLossConfig};
+use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::SsimBackend;
 use crate::losses::blur::{TAPS, as_f32};
 
 type B = CubeBackend;
-
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("image sizes index within u32")
-}
-
-fn empty(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
-    B::float_empty(shape.into(), &like.device, FloatDType::F32)
-}
-
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
 
 fn weights(config: &ImageLossConfig, like: &CubeTensor) -> CubeTensor {
     let n = config.weights.len();
@@ -49,8 +35,8 @@ impl ImageLossBackend for CubeBackend {
         let (pred, back) = as_f32(pred);
         let [alpha, target, mask] = [alpha, target, mask].map(|t| as_f32(t).0);
         let (map, moments) = <B as SsimBackend>::ssim_forward(pred.clone(), target.clone());
-        let share = empty(vec![h * w], &pred);
-        let (count, dim) = grid(&pred, h * w);
+        let share = empty_f32(vec![h * w], &pred);
+        let (count, dim) = per_element(&pred, h * w);
         loss_shares::launch(
             &pred.client,
             count,
@@ -85,8 +71,8 @@ impl ImageLossBackend for CubeBackend {
         let [alpha, target, mask, grad] = [alpha, target, mask, grad].map(|t| as_f32(t).0);
         let weights = weights(&config, &pred);
         let (mh, mw) = (h + 1 - TAPS, w + 1 - TAPS);
-        let d_map = empty(vec![c, mh, mw], &pred);
-        let (count, dim) = grid(&pred, c * mh * mw);
+        let d_map = empty_f32(vec![c, mh, mw], &pred);
+        let (count, dim) = per_element(&pred, c * mh * mw);
         map_gradient::launch(
             &pred.client,
             count,
@@ -101,8 +87,8 @@ impl ImageLossBackend for CubeBackend {
         );
         let (d_ssim, _) =
             <B as SsimBackend>::ssim_backward(pred.clone(), target.clone(), moments, d_map, true, false);
-        let (d_pred, d_alpha) = (empty(vec![c, h, w], &pred), empty(vec![h, w], &pred));
-        let (count, dim) = grid(&pred, h * w);
+        let (d_pred, d_alpha) = (empty_f32(vec![c, h, w], &pred), empty_f32(vec![h, w], &pred));
+        let (count, dim) = per_element(&pred, h * w);
         let client = pred.client.clone();
         pixel_gradients::launch(
             &client,

@@ -8,29 +8,14 @@ use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
 use burn::tensor::FloatDType;
-use burn_cubecl::cubecl;
-use cubecl::prelude::*;
 
 use super::kernels::{face_terms, gather_corners, hinge_terms, laplacian_deltas, laplacian_gather};
 use super::tables::{Tables, tables};
 use super::{HostTerm, MeshLoss, MeshLossBackend};
+use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
 
 type B = CubeBackend;
-
-fn u32_of(n: usize) -> u32 {
-    u32::try_from(n).expect("mesh sizes fit u32")
-}
-
-fn empty(len: usize, like: &CubeTensor) -> CubeTensor {
-    B::float_empty([len].into(), &like.device, FloatDType::F32)
-}
-
-/// Launch geometry for one unit per element.
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
 
 /// `1/N` over the connected vertices (the Laplacian's mean).
 fn laplacian_scale(loss: &MeshLoss) -> f32 {
@@ -40,8 +25,8 @@ fn laplacian_scale(loss: &MeshLoss) -> f32 {
 /// The Laplacian's δ `[V·3]` and loss shares `[V]`.
 fn deltas(v: &CubeTensor, t: &Tables, loss: &MeshLoss) -> (CubeTensor, CubeTensor) {
     let n = loss.mesh.rings.num_vertices;
-    let (delta, share) = (empty(3 * n, v), empty(n, v));
-    let (count, dim) = grid(v, n);
+    let (delta, share) = (empty_f32(vec![3 * n], v), empty_f32(vec![n], v));
+    let (count, dim) = per_element(v, n);
     laplacian_deltas::launch(
         &v.client,
         count,
@@ -61,8 +46,8 @@ fn deltas(v: &CubeTensor, t: &Tables, loss: &MeshLoss) -> (CubeTensor, CubeTenso
 /// `[E]`, or per-corner gradients `[E·corners·3]` when `backward`.
 fn element_terms(v: &CubeTensor, t: &Tables, term: HostTerm, elements: usize, backward: bool) -> CubeTensor {
     let corners = if term == HostTerm::Equilateral { 3 } else { 4 };
-    let out = empty(if backward { elements * corners * 3 } else { elements }, v);
-    let (count, dim) = grid(v, elements);
+    let out = empty_f32(vec![if backward { elements * corners * 3 } else { elements }], v);
+    let (count, dim) = per_element(v, elements);
     let (v_arg, out_arg, e) = (v.clone().into_buffer_arg(), out.clone().into_buffer_arg(), u32_of(elements));
     if term == HostTerm::Equilateral {
         face_terms::launch(
@@ -121,7 +106,7 @@ impl MeshLossBackend for CubeBackend {
         let (upstream, _) = as_f32(grad);
         let t = tables(&loss.mesh, &v.device);
         let out = B::float_empty([n, 3].into(), &v.device, FloatDType::F32);
-        let (count, dim) = grid(&v, n);
+        let (count, dim) = per_element(&v, n);
         match loss.term {
             HostTerm::Laplacian => {
                 let (delta, _) = deltas(&v, &t, &loss);

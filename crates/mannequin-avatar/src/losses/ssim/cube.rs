@@ -5,31 +5,15 @@
 use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
-use burn::backend::wgpu::{CubeBackend, CubeTensor};
-use burn::tensor::FloatDType;
-use burn_cubecl::cubecl;
+use burn::backend::wgpu::CubeBackend;
 use burn_cubecl::kernel::into_contiguous;
-use cubecl::prelude::*;
 
 use super::kernels::{moment_planes, ssim_coefficients, ssim_combine, ssim_map};
 use super::{C1, C2, SsimBackend};
+use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::{TAPS, as_f32, blur_f32};
 
 type B = CubeBackend;
-
-fn u32_of(v: usize) -> u32 {
-    u32::try_from(v).expect("SSIM sizes index within u32")
-}
-
-fn empty(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
-    B::float_empty(shape.into(), &like.device, FloatDType::F32)
-}
-
-/// Launch geometry for one unit per element.
-fn grid(like: &CubeTensor, n: usize) -> (CubeCount, CubeDim) {
-    let dim = CubeDim::new_1d(256);
-    (cubecl::calculate_cube_count_elemwise(&like.client, n.max(1), dim), dim)
-}
 
 impl SsimBackend for CubeBackend {
     fn ssim_forward(x: FloatTensor<Self>, y: FloatTensor<Self>) -> (FloatTensor<Self>, FloatTensor<Self>) {
@@ -37,8 +21,8 @@ impl SsimBackend for CubeBackend {
         let (x, back) = as_f32(x);
         let (y, _) = as_f32(y);
         let size = c * h * w;
-        let planes = empty(vec![5 * c, h, w], &x);
-        let (count, dim) = grid(&x, size);
+        let planes = empty_f32(vec![5 * c, h, w], &x);
+        let (count, dim) = per_element(&x, size);
         moment_planes::launch(
             &x.client,
             count,
@@ -51,8 +35,8 @@ impl SsimBackend for CubeBackend {
         let moments = blur_f32(planes, 0);
         let (oh, ow) = (h + 1 - TAPS, w + 1 - TAPS);
         let plane = c * oh * ow;
-        let map = empty(vec![c, oh, ow], &moments);
-        let (count, dim) = grid(&moments, plane);
+        let map = empty_f32(vec![c, oh, ow], &moments);
+        let (count, dim) = per_element(&moments, plane);
         ssim_map::launch(
             &moments.client,
             count,
@@ -81,8 +65,8 @@ impl SsimBackend for CubeBackend {
         let moments = into_contiguous(moments);
         let (oh, ow) = (h + 1 - TAPS, w + 1 - TAPS);
         let plane = c * oh * ow;
-        let coeff = empty(vec![4 * c, oh, ow], &moments);
-        let (count, dim) = grid(&moments, plane);
+        let coeff = empty_f32(vec![4 * c, oh, ow], &moments);
+        let (count, dim) = per_element(&moments, plane);
         ssim_coefficients::launch(
             &moments.client,
             count,
@@ -96,8 +80,8 @@ impl SsimBackend for CubeBackend {
         );
         let t = blur_f32(coeff, TAPS - 1);
         let size = c * h * w;
-        let (dx, dy) = (empty(vec![c, h, w], &t), empty(vec![c, h, w], &t));
-        let (count, dim) = grid(&t, size);
+        let (dx, dy) = (empty_f32(vec![c, h, w], &t), empty_f32(vec![c, h, w], &t));
+        let (count, dim) = per_element(&t, size);
         ssim_combine::launch(
             &t.client,
             count,
