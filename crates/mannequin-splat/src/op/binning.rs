@@ -458,7 +458,14 @@ mod tests {
     /// Bins `cloud` on the device and on the CPU (from the same projection) and requires the
     /// same lists, tile by tile, in the same order.
     fn same_lists(name: &str, cloud: &Cloud, camera: Camera, options: RenderOptions) -> Stats {
-        let config = SplatConfig { camera, options, matrices: false, sh_degree: None, color_len: 3 };
+        let config = SplatConfig {
+            camera,
+            options,
+            matrices: false,
+            sh_degree: None,
+            color_len: 3,
+            header: Default::default(),
+        };
         let d = device();
         let n = cloud.len();
         let inputs = [

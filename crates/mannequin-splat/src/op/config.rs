@@ -1,6 +1,8 @@
 //! What the op knows besides its tensors: the camera, the rules and the input forms (host data,
 //! not differentiated), and the flat inputs read as the CPU renderer's Gaussians.
 
+use std::sync::{Arc, OnceLock};
+
 use crate::gaussians::{Colors, Gaussians, Rotations};
 use crate::{Camera, RenderOptions, SplatError};
 
@@ -25,6 +27,10 @@ pub struct SplatConfig {
     pub sh_degree: Option<usize>,
     /// Values per Gaussian in the colour input.
     pub color_len: usize,
+    /// The saved state's header as the CubeCL forward wrote it, kept on the host: the backward
+    /// gets a clone of this config and so need not wait for a read-back from the device. Each
+    /// config serves one forward ([`super::splat_render`] makes one per call).
+    pub(crate) header: Arc<OnceLock<Vec<f32>>>,
 }
 
 impl SplatConfig {

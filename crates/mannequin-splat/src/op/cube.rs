@@ -14,10 +14,10 @@ use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
 use burn_cubecl::kernel::into_contiguous;
 
 use super::binning::bin;
-use super::device_buffers::{buffer, read, u32_of, units_dim, units_grid, upload, zeros};
+use super::device_buffers::{buffer, u32_of, units_dim, units_grid, upload, zeros};
 use super::kernels::{LayoutLaunch, composite_backward, composite_forward};
 use super::project_kernels::{camera_words, project_backward, project_forward};
-use super::saved::{HEADER, WordLayout, size_words};
+use super::saved::{WordLayout, size_words};
 use super::{SplatBackend, SplatConfig};
 use crate::camera::CameraParams;
 use crate::composite::field;
@@ -115,6 +115,8 @@ impl SplatBackend for CubeBackend {
         let sizes = [p.stride, tiles_x, tiles_y, 0, n_offsets, tiles.n_ids, w * h, n * p.stride];
         let head = size_words(sizes);
         let layout = WordLayout::parse(&head).expect("sizes just written");
+        // A second forward on one config would leave the first header: never, see the field.
+        let _ = config.header.set(head.clone());
         let mut parts = vec![upload(head, &like), p.skipped, tiles.offsets];
         parts.extend(tiles.ids);
         parts.push(p.rows);
@@ -152,7 +154,7 @@ impl SplatBackend for CubeBackend {
         let shape = |t: &CubeTensor| t.shape().to_vec();
         let d = [&means, &rotations, &scales, &opacities, &colors].map(|t| zeros(shape(t), &like));
         let c = config.channels();
-        let head = read(Self::float_slice(saved.clone(), &[(0..HEADER).into()]));
+        let head = config.header.get().expect("splat_forward wrote the header on this config").clone();
         let layout = WordLayout::parse(&head).expect("the state splat_forward saved");
         let sums = zeros(vec![n.max(1) * (SCREEN_GRADS + c)], &like);
         composite_backward::launch(

@@ -170,8 +170,14 @@ pub fn splat_render(
             (f, None, c)
         }
     };
-    let config =
-        SplatConfig { camera: camera.clone(), options: options.clone(), matrices, sh_degree, color_len };
+    let config = SplatConfig {
+        camera: camera.clone(),
+        options: options.clone(),
+        matrices,
+        sh_degree,
+        color_len,
+        header: Default::default(),
+    };
     camera.validate()?;
     config.options_checked()?;
     let (h, w, ch) = (camera.height, camera.width, config.channels());
