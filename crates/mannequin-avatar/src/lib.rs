@@ -27,6 +27,7 @@ pub mod host_ops;
 pub mod ihuman;
 pub mod losses;
 pub mod mesh_gaussians;
+mod mesh_tables;
 pub mod mlp;
 pub mod one_ring_mesh;
 pub mod options;

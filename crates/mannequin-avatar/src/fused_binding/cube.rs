@@ -3,7 +3,7 @@
 //! in f32; other float types are converted on the way in and out. The mesh's index tables go to
 //! each device once and stay there while the mesh lives.
 
-use std::sync::{Arc, Mutex, PoisonError, Weak};
+use std::sync::{Arc, Mutex};
 
 use burn::backend::ops::{FloatTensorOps, IntTensorOps};
 use burn::backend::tensor::FloatTensor;
@@ -16,6 +16,7 @@ use super::{BindConfig, BindingBackend, PACKED, plane_starts};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
 use crate::mesh_gaussians::{FACE_SCALE, NORM_EPS, NORMAL_SCALE, VERTEX_SCALE};
+use crate::mesh_tables::{TableCache, cached, csr};
 use crate::one_ring_mesh::OneRingMesh;
 
 type B = CubeBackend;
@@ -30,31 +31,13 @@ struct Tables {
     rings: CubeTensor,
 }
 
-/// `[0, n₀, n₀ + n₁, …]`.
-fn starts(counts: impl Iterator<Item = usize>) -> Vec<u32> {
-    let ends = counts.scan(0, |end, n| {
-        *end += n;
-        Some(*end)
-    });
-    std::iter::once(0).chain(ends).map(u32_of).collect()
-}
-
 impl Tables {
     fn upload(mesh: &OneRingMesh, device: &CubeDevice) -> Self {
         let nv = mesh.num_vertices;
-        let mut counts = vec![0; nv];
-        for &i in mesh.faces.iter().flatten() {
-            counts[i as usize] += 1;
-        }
-        let corner_start = starts(counts.into_iter());
-        // Faces in ascending order, so each vertex's corners come in face order.
-        let mut next: Vec<u32> = corner_start[..nv].to_vec();
-        let mut corners = vec![0; 3 * mesh.faces.len()];
-        for (k, &i) in mesh.faces.iter().flatten().enumerate() {
-            corners[next[i as usize] as usize] = u32_of(k);
-            next[i as usize] += 1;
-        }
-        let rings: Vec<u32> = (0..nv).flat_map(|i| mesh.ring(i).iter().copied()).collect();
+        // Each vertex's corners (3f + k) in ascending face order.
+        let (corner_start, corners) =
+            csr(nv, mesh.faces.iter().flatten().enumerate().map(|(k, &i)| (i as usize, u32_of(k))));
+        let (ring_start, rings) = csr(nv, (0..nv).flat_map(|i| mesh.ring(i).iter().map(move |&j| (i, j))));
         let upload = |t: Vec<u32>| {
             let n = t.len();
             B::int_from_data(TensorData::new(t, [n]), device)
@@ -63,25 +46,15 @@ impl Tables {
             faces: upload(mesh.faces.concat()),
             corner_start: upload(corner_start),
             corners: upload(corners),
-            ring_start: upload(starts((0..nv).map(|i| mesh.ring(i).len()))),
+            ring_start: upload(ring_start),
             rings: upload(rings),
         }
     }
 
-    /// The tables of `mesh` on `device`, uploaded on first use. An entry holds a `Weak` of its
-    /// mesh, which keeps the allocation and so its address from being reused while the entry
-    /// exists; entries of dropped meshes go at the next call.
+    /// The tables of `mesh` on `device`, uploaded on first use.
     fn of(mesh: &Arc<OneRingMesh>, device: &CubeDevice) -> Self {
-        static CACHE: Mutex<Vec<(Weak<OneRingMesh>, CubeDevice, Tables)>> = Mutex::new(Vec::new());
-        let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
-        cache.retain(|(m, _, _)| m.strong_count() > 0);
-        let key = Arc::downgrade(mesh);
-        if let Some((_, _, t)) = cache.iter().find(|(m, d, _)| m.ptr_eq(&key) && d == device) {
-            return t.clone();
-        }
-        let t = Self::upload(mesh, device);
-        cache.push((key, device.clone(), t.clone()));
-        t
+        static CACHE: TableCache<OneRingMesh, Tables> = Mutex::new(Vec::new());
+        cached(&CACHE, mesh, device, || Self::upload(mesh, device))
     }
 }
 

@@ -2,7 +2,7 @@
 //! the one-rings (the Laplacian's gathers), the faces and hinges, and per vertex the corner slots
 //! of the faces and hinges it belongs to (the backward's gathers, which need no atomics).
 
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::{Arc, Mutex};
 
 use burn::backend::ops::IntTensorOps;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
@@ -10,6 +10,7 @@ use burn::tensor::TensorData;
 use burn_cubecl::CubeDevice;
 
 use super::HostMesh;
+use crate::mesh_tables::{TableCache, cached, csr};
 
 /// Index tables as `i32` `[n]` tensors.
 pub(super) struct Tables {
@@ -27,26 +28,11 @@ pub(super) struct Tables {
     pub hinge_slots: CubeTensor,
 }
 
-struct Entry {
-    /// Held weakly, so the entry does not keep the mesh alive; while the entry exists the
-    /// allocation is not reused, so the address identifies the mesh.
-    mesh: Weak<HostMesh>,
-    device: CubeDevice,
-    tables: Arc<Tables>,
-}
-
-static CACHE: Mutex<Vec<Entry>> = Mutex::new(Vec::new());
+static CACHE: TableCache<HostMesh, Arc<Tables>> = Mutex::new(Vec::new());
 
 /// The tables of `mesh` on `device`, uploaded on first use.
 pub(super) fn tables(mesh: &Arc<HostMesh>, device: &CubeDevice) -> Arc<Tables> {
-    let mut cache = CACHE.lock().expect("the mesh table cache is not poisoned");
-    cache.retain(|e| e.mesh.strong_count() > 0);
-    if let Some(e) = cache.iter().find(|e| e.mesh.as_ptr() == Arc::as_ptr(mesh) && e.device == *device) {
-        return e.tables.clone();
-    }
-    let tables = Arc::new(upload(mesh, device));
-    cache.push(Entry { mesh: Arc::downgrade(mesh), device: device.clone(), tables: tables.clone() });
-    tables
+    cached(&CACHE, mesh, device, || Arc::new(upload(mesh, device)))
 }
 
 fn upload(mesh: &HostMesh, device: &CubeDevice) -> Tables {
@@ -78,23 +64,4 @@ fn upload(mesh: &HostMesh, device: &CubeDevice) -> Tables {
         hinge_start: up(&hinge_start),
         hinge_slots: up(&hinge_slots),
     }
-}
-
-/// Offsets `[n + 1]` and entries of the lists of `n` rows, from `(row, entry)` pairs in the
-/// order each row's list keeps.
-fn csr(n: usize, pairs: impl Iterator<Item = (usize, u32)> + Clone) -> (Vec<u32>, Vec<u32>) {
-    let mut start = vec![0u32; n + 1];
-    for (row, _) in pairs.clone() {
-        start[row + 1] += 1;
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut entries = vec![0u32; start[n] as usize];
-    for (row, e) in pairs {
-        entries[fill[row] as usize] = e;
-        fill[row] += 1;
-    }
-    (start, entries)
 }
