@@ -2,6 +2,7 @@
 //! arguments and a `run` function; this file only dispatches and reports errors.
 
 mod animate;
+mod batch;
 mod body;
 mod capture;
 mod cloth;
@@ -21,7 +22,7 @@ mod synth;
 mod train;
 mod view;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(name = "mannequin", version, about = "Animatable, clothed 3D digital humans")]
@@ -80,6 +81,10 @@ enum Command {
     /// Export a trained avatar: its mesh (.obj/.ply, canonical or posed), a skinned coloured .glb,
     /// or its Gaussians at a pose as a 3DGS .ply.
     Export(export::Args),
+    /// Many people as an array of tasks: a manifest planned for Slurm, Kubernetes or this
+    /// machine, each person's steps resumable, and a report of them all.
+    #[command(subcommand)]
+    Batch(batch::BatchCommand),
     /// Look at an avatar (its Gaussians animated), a dressed body, a cloth simulation, a .glb or a
     /// 3DGS .ply in the browser: a local server on 127.0.0.1 with an embedded page.
     View(view::Args),
@@ -99,6 +104,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Motion(cmd) => motion::run(cmd),
         Command::Animate(args) => animate::run(args),
         Command::Demo(args) => demo::run(args, run_verb),
+        Command::Batch(cmd) => batch::run(cmd, &run_verb, Cli::command()),
         Command::Eval(args) => eval::run(args),
         Command::Synth(args) => synth::run(args),
         Command::Splat(args) => splat::run(args),
