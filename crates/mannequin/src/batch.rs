@@ -41,6 +41,10 @@ pub enum BatchCommand {
         /// The person's index in the manifest, from 0.
         #[arg(long)]
         index: Option<usize>,
+        /// Added to the index from the environment: the first person of this array's part of a
+        /// run split into several arrays.
+        #[arg(long, default_value_t = 0, conflicts_with = "index")]
+        offset: usize,
     },
     /// Run every person on this machine, --jobs at a time, each task its own process.
     Local {
@@ -100,6 +104,9 @@ pub struct PlanArgs {
     /// Slurm partition.
     #[arg(long)]
     partition: Option<String>,
+    /// Slurm's MaxArraySize: a run of more people is split into several scripts.
+    #[arg(long, default_value_t = 1001, value_parser = clap::value_parser!(u32).range(2..))]
+    array_max: u32,
     /// The mannequin binary the Slurm tasks run (default: this one).
     #[arg(long)]
     mannequin: Option<PathBuf>,
@@ -120,7 +127,7 @@ pub struct PlanArgs {
 pub fn run(cmd: BatchCommand, run_verb: &dyn Fn(&[&str]) -> Result<()>, cli: clap::Command) -> Result<()> {
     match cmd {
         BatchCommand::Plan(args) => plan(args, &cli),
-        BatchCommand::Task { run, index } => task::run(&run, task::index(index)?, run_verb),
+        BatchCommand::Task { run, index, offset } => task::run(&run, task::index(index, offset)?, run_verb),
         BatchCommand::Local { run, jobs, threads } => {
             local::run(&run, jobs.get(), threads.map(NonZeroUsize::get))
         }
@@ -206,11 +213,20 @@ fn plan(args: PlanArgs, cli: &clap::Command) -> Result<()> {
                 Some(p) => absolute(&p)?,
                 None => std::env::current_exe().context("cannot find this mannequin binary")?,
             };
-            let path = run.join("slurm.sbatch");
-            let text = slurm::script(&plan, &run, &exe, args.throttle, args.partition.as_deref());
-            write_atomic(&path, text.as_bytes())
-                .with_context(|| format!("{}: cannot write", path.display()))?;
-            tracing::info!("planned {n} people; submit with `sbatch {}`", path.display());
+            let scripts = slurm::scripts(
+                &plan,
+                &run,
+                &exe,
+                args.throttle,
+                args.partition.as_deref(),
+                args.array_max as usize,
+            );
+            for (path, text) in &scripts {
+                write_atomic(path, text.as_bytes())
+                    .with_context(|| format!("{}: cannot write", path.display()))?;
+            }
+            let names: Vec<String> = scripts.iter().map(|(p, _)| format!("sbatch {}", p.display())).collect();
+            tracing::info!("planned {n} people; submit with `{}`", names.join("`, `"));
         }
         (Engine::Kubernetes, Some(image), Some(mount)) => {
             let cluster = kubernetes::Cluster {

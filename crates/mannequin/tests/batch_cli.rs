@@ -109,6 +109,7 @@ fn a_failing_person_does_not_stop_the_others_and_a_rerun_finishes_only_what_is_l
     let people = status["people"].as_array().unwrap();
     let state = |i: usize| people[i]["status"].as_str().unwrap().to_string();
     assert_eq!([state(0), state(1), state(2)], ["done", "failed", "done"]);
+    assert_eq!(status["left"], serde_json::json!([1]));
     let bob_train = &people[1]["steps"][0];
     assert_eq!(bob_train["status"], "failed");
     let error = bob_train["error"].as_str().unwrap();
@@ -171,6 +172,36 @@ fn the_task_index_comes_from_job_completion_index() {
     assert!(!run.join("people/anna/steps").exists(), "index 1 ran anna");
     one_line_error(&task(Some("2")), &["task index 2", "2 people"]);
     one_line_error(&task(None), &["JOB_COMPLETION_INDEX"]);
+}
+
+#[test]
+fn a_run_larger_than_slurms_array_limit_is_split_and_each_part_finds_its_people() {
+    let dir = scratch("batch_split");
+    let d = s(subject());
+    let rows: Vec<String> =
+        ["a", "b", "c"].iter().map(|id| format!("{id},{d},train,1,default-lod1")).collect();
+    let manifest = write(
+        &dir.join("people.csv"),
+        &format!("id,input,steps,train.iters,train.body\n{}\n", rows.join("\n")),
+    );
+    let run = dir.join("run");
+    let plan = ["batch", "plan", "--manifest", s(&manifest), "--engine", "slurm", "--out", s(&run)];
+    ok(mannequin(&[&plan[..], &["--array-max", "2"]].concat()));
+    assert!(!run.join("slurm.sbatch").exists());
+    let first = std::fs::read_to_string(run.join("slurm-0.sbatch")).unwrap();
+    let second = std::fs::read_to_string(run.join("slurm-1.sbatch")).unwrap();
+    assert!(first.contains("--array=0-1\n") && first.contains("--offset 0\n"), "{first}");
+    assert!(second.contains("--array=0-0\n") && second.contains("--offset 2\n"), "{second}");
+    // The second script's only task, as Slurm starts it.
+    let o = Command::new(env!("CARGO_BIN_EXE_mannequin"))
+        .args(["batch", "task", "--run", s(&run), "--offset", "2"])
+        .env("SLURM_ARRAY_TASK_ID", "0")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .output()
+        .unwrap();
+    ok(o);
+    assert_eq!(record(&run, "c", "train")["state"], "done");
+    assert!(!run.join("people/a/steps").exists() && !run.join("people/b/steps").exists());
 }
 
 /// `kubernetes-validate`: on the PATH, or where `.ci/run` installs it.

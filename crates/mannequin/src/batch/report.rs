@@ -69,6 +69,8 @@ pub struct RunReport {
     pub people: Vec<PersonReport>,
     /// How many people are in each status.
     pub counts: BTreeMap<String, usize>,
+    /// The indices of the people not done, which an array can be resubmitted with alone.
+    pub left: Vec<usize>,
 }
 
 /// Reads the run folder's records.
@@ -115,7 +117,8 @@ pub fn gather(run: &Path) -> Result<RunReport> {
     for p in &people {
         *counts.entry(p.status.name().to_string()).or_insert(0) += 1;
     }
-    Ok(RunReport { run: run.display().to_string(), people, counts })
+    let left = people.iter().filter(|p| p.status != Status::Done).map(|p| p.index).collect();
+    Ok(RunReport { run: run.display().to_string(), people, counts, left })
 }
 
 /// PSNR, SSIM and LPIPS of each test set in an `eval.json`, if it has been written.
@@ -135,11 +138,20 @@ fn scores(path: &Path) -> Result<BTreeMap<String, BTreeMap<String, f64>>> {
     Ok(out)
 }
 
-/// A line of counts, e.g. `3 people: 2 done, 1 failed`.
+/// A line of counts, e.g. `3 people: 2 done, 1 failed`, and the indices left, if any.
 fn summary(report: &RunReport) -> String {
     let total: usize = report.counts.values().sum();
     let parts: Vec<String> = report.counts.iter().map(|(k, v)| format!("{v} {k}")).collect();
-    format!("{total} people: {}", parts.join(", "))
+    let mut line = format!("{total} people: {}", parts.join(", "));
+    if !report.left.is_empty() {
+        let left: Vec<String> = report.left.iter().map(usize::to_string).collect();
+        line.push_str(&format!(
+            "\nleft: indices {} (an array of these alone: sbatch --array={} slurm.sbatch)",
+            left.join(","),
+            left.join(",")
+        ));
+    }
+    line
 }
 
 /// The status table: a row per person, a column per step.

@@ -17,17 +17,17 @@ use super::step::Step;
 /// The environment variables the engines hand a task its index in.
 pub const INDEX_VARIABLES: [&str; 2] = ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"];
 
-/// The task's index: `given`, else the first of [`INDEX_VARIABLES`] that is set.
-pub fn index(given: Option<usize>) -> Result<usize> {
+/// The task's index: `given`, else the first of [`INDEX_VARIABLES`] that is set plus `offset`.
+pub fn index(given: Option<usize>, offset: usize) -> Result<usize> {
     if let Some(i) = given {
         return Ok(i);
     }
     for name in INDEX_VARIABLES {
         if let Ok(text) = std::env::var(name) {
-            return text
-                .trim()
-                .parse()
-                .with_context(|| format!("{name}={text}: expected the task's index, a whole number from 0"));
+            let i: usize = text.trim().parse().with_context(|| {
+                format!("{name}={text}: expected the task's index, a whole number from 0")
+            })?;
+            return Ok(i + offset);
         }
     }
     bail!("no --index, and neither {} is set", INDEX_VARIABLES.join(" nor "))
