@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use common::{mannequin, ok, one_line_error, read_json, s, scratch};
+use common::{copy_dir, mannequin, ok, one_line_error, read_json, s, scratch};
 
 /// A tiny synthetic dataset (64², 10 frames, the light body), made once for every test here:
 /// batch runs only read their inputs, so people may share one.
@@ -259,17 +259,4 @@ fn the_kubernetes_job_meets_the_job_api_schema() {
     // The check can fail: a Job with a count as text is refused.
     let bad = write(&dir.join("bad.yaml"), &job.replace("completions: 2", "completions: \"two\""));
     assert!(!check(&bad).status.success(), "kubernetes-validate took a malformed Job");
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_dir(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), target).unwrap();
-        }
-    }
 }

@@ -105,19 +105,7 @@ pub fn broken_bytes(good: &[u8]) -> Vec<(String, Vec<u8>)> {
     out
 }
 
-/// Copies the folder `from` to `to` (files and subfolders), for a case that mutates a fixture.
-pub fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_dir(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), &target).unwrap();
-        }
-    }
-}
+pub use crate::common::copy_dir;
 
 /// The `.npz` at `from` written to `to` with `key` replaced by `array` (or removed when `None`;
 /// added when the archive lacks it), every other array as it was.

@@ -10,6 +10,9 @@ use super::plan::Plan;
 use super::resources::Needs;
 use super::step::Step;
 
+/// Slurm's default MaxArraySize: array indices run from 0 to 1000.
+pub const MAX_ARRAY_SIZE: usize = 1001;
+
 /// One script's part of the run: its people are `first..first + count`.
 struct Chunk {
     first: usize,

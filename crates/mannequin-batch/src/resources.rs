@@ -1,7 +1,8 @@
 //! What one person's task asks the scheduler for: each step's CPUs, memory and time on one
-//! node, from the per-step times and peaks measured at the default settings (docs/scale.md),
-//! with room to spare; a task asks for the most CPUs and memory of its steps and the sum of
-//! their times.
+//! node, from the per-step times and peaks measured at the default settings (docs/scale.md:
+//! 46 s, 177 s, 0.2 s and 125 s for capture, train, export and eval, 855 MiB at most; garments
+//! from docs/ngd.md's 10 minutes per 100 frames), with room to spare; a task asks for the most
+//! CPUs and memory of its steps and the sum of their times.
 
 use serde::{Deserialize, Serialize};
 
@@ -19,11 +20,11 @@ impl Needs {
     /// A step's needs at the default settings on a 2-core node.
     pub fn of(step: Step) -> Needs {
         let (cpus, memory_gib, minutes) = match step {
-            Step::Capture => (2, 4, 20),
-            Step::Train => (2, 6, 40),
-            Step::Garments => (2, 4, 30),
-            Step::Export => (1, 3, 5),
-            Step::Eval => (2, 4, 15),
+            Step::Capture => (2, 2, 5),
+            Step::Train => (2, 2, 10),
+            Step::Garments => (2, 2, 20),
+            Step::Export => (1, 1, 2),
+            Step::Eval => (2, 2, 8),
         };
         Needs { cpus, memory_gib, minutes }
     }
