@@ -18,6 +18,7 @@ mod make;
 pub mod ngd;
 mod panel;
 pub mod region;
+pub mod segmentation;
 mod sewing;
 mod transfer;
 mod wear;

@@ -16,6 +16,7 @@ mod garment;
 mod logging;
 mod motion;
 mod render;
+mod segment;
 mod shared;
 mod splat;
 mod synth;
@@ -51,6 +52,9 @@ enum Command {
     /// A person's own video (or frames) to a dataset `train` reads: landmarks and masks by the
     /// shipped person models, one body shape, a pose per frame, one static camera.
     Capture(capture::Args),
+    /// Garment labels from a dataset's images, person masks and poses alone (`auto` decides the
+    /// garments): labels/, hands/ and the legend, as `garment fit` and `train --garments` read them.
+    Segment(segment::Args),
     /// Fit the body to a person in a photo: detection, landmarks and mask by the shipped person
     /// models, then shape, pose and camera (body.npz, .obj, .glb, overlay.png, fit.json).
     Fit(fit::Args),
@@ -99,6 +103,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Dress(args) => dress::run(args),
         Command::Capture(args) => capture::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Segment(args) => segment::run(args),
         Command::View(args) => view::run(args),
         Command::Face(cmd) => face::run(cmd),
         Command::Motion(cmd) => motion::run(cmd),

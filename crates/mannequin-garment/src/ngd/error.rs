@@ -4,9 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use mannequin_body::LoadBodyError;
+use mannequin_body::{BodyError, LoadBodyError};
 use mannequin_data::DataError;
 use mannequin_io::IoError;
+use mannequin_io::staging::StagingError;
 use mannequin_mesh::MeshFileError;
 
 use crate::dress_error::DressError;
@@ -43,6 +44,10 @@ pub enum NgdError {
     Data(#[from] DataError),
     #[error(transparent)]
     Body(#[from] LoadBodyError),
+    #[error(transparent)]
+    Pose(#[from] BodyError),
+    #[error(transparent)]
+    Staging(#[from] StagingError),
     #[error(transparent)]
     Mesh(#[from] MeshFileError),
     #[error(transparent)]

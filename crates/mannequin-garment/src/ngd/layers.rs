@@ -58,7 +58,7 @@ pub fn resolve(spec: &str, data: &Path) -> Result<Vec<Category>, NgdError> {
 }
 
 /// `part:category` or `category`, the part (`upper` or `lower`) checked against the category.
-fn parse_item(item: &str) -> Result<Category, NgdError> {
+pub(crate) fn parse_item(item: &str) -> Result<Category, NgdError> {
     let (part, name) = match item.split_once(':') {
         Some((part, name)) => (Some(part), name),
         None => (None, item),
