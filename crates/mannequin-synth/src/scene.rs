@@ -18,6 +18,7 @@ use mannequin_data::Camera;
 use mannequin_data::image::{Image, Mask};
 use mannequin_data::labels::LabelMap;
 use mannequin_data::maps::{DepthMap, NormalMap};
+use mannequin_garment::segmentation::BODY_LABELS;
 use mannequin_io::rng::SplitMix64;
 use mannequin_raster::{NO_FACE, RasterMesh, Shading, rasterize};
 
@@ -138,9 +139,6 @@ fn remap_uv(uv: &UvLayout, offset: f32, scale: f32, base: u32) -> (Vec<[f32; 2]>
         uv.faces.iter().map(|f| f.map(|i| i + base)).collect(),
     )
 }
-
-/// Labels of the body's faces (skin, hair, shoes) and of each garment after them.
-pub const BODY_LABELS: [&str; 4] = ["background", "skin", "hair", "shoes"];
 
 impl Scene {
     pub fn new(model: &BodyModel, subject: &Subject) -> Result<Self, SynthError> {

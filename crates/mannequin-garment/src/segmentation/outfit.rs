@@ -15,8 +15,12 @@ pub const LONG_SLEEVE: f64 = 0.5;
 /// Above this share of the shins showing the lower garment, it reaches the ankles.
 pub const FULL_LENGTH: f64 = 0.5;
 /// Above this share of the rows across both thighs showing the lower garment as one unbroken
-/// run, it hangs free between the legs: a skirt.
-pub const SKIRT_SPAN: f64 = 0.8;
+/// run, a lower garment that leaves the shins bare hangs free between the legs: a skirt, not
+/// shorts.
+pub const SKIRT_SPAN: f64 = 0.5;
+/// A lower garment that covers the shins is a long skirt only where it joins the legs in nearly
+/// every row: trousers, loose or seen at low resolution, join them in up to 0.83 (measured).
+pub const LONG_SKIRT_SPAN: f64 = 0.95;
 
 /// What the clip showed that the decision reads.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
@@ -74,12 +78,11 @@ impl Outfit {
             return Outfit::Dress;
         }
         let upper = if e.forearms_covered > LONG_SLEEVE { Category::Shirt } else { Category::Tshirt };
-        let lower = if e.legs_joined > SKIRT_SPAN {
-            Category::Skirt
-        } else if e.shins_covered > FULL_LENGTH {
-            Category::Pants
-        } else {
-            Category::ShortPants
+        let lower = match (e.shins_covered > FULL_LENGTH, e.legs_joined) {
+            (true, joined) if joined > LONG_SKIRT_SPAN => Category::Skirt,
+            (true, _) => Category::Pants,
+            (false, joined) if joined > SKIRT_SPAN => Category::Skirt,
+            (false, _) => Category::ShortPants,
         };
         Outfit::TwoPiece { upper, lower }
     }
@@ -128,8 +131,10 @@ mod tests {
     #[test]
     fn auto_reads_sleeves_legs_and_the_span_between_the_legs() {
         assert_eq!(Outfit::decide(&evidence(0.9, 0.0, 0.0, 0.5)), Outfit::Dress);
-        let o = Outfit::decide(&evidence(0.1, 0.1, 0.9, 0.1));
+        let o = Outfit::decide(&evidence(0.1, 0.1, 0.9, 0.8));
         assert_eq!(o, Outfit::TwoPiece { upper: Category::Tshirt, lower: Category::Pants });
+        let o = Outfit::decide(&evidence(0.1, 0.1, 0.9, 0.99));
+        assert_eq!(o, Outfit::TwoPiece { upper: Category::Tshirt, lower: Category::Skirt });
         let o = Outfit::decide(&evidence(0.1, 0.8, 0.1, 0.8));
         assert_eq!(o, Outfit::TwoPiece { upper: Category::Shirt, lower: Category::Skirt });
         let o = Outfit::decide(&evidence(0.1, 0.1, 0.1, 0.0));
