@@ -138,11 +138,6 @@ fn parse_steps(text: &str, kind: InputKind) -> Result<Vec<Step>> {
     if let Some(step) = steps.iter().find(|s| s.needs_train() && !has(Step::Train)) {
         bail!("`{}` needs `train` in the same row", step.name());
     }
-    if has(Step::Garments) && has(Step::Capture) {
-        bail!(
-            "`garments` reads garment label maps, which a captured dataset does not have yet; give a dataset with labels/ and no capture"
-        );
-    }
     Ok(steps)
 }
 

@@ -25,7 +25,10 @@ use mannequin_data::labels::LabelMap;
 mod bench_args;
 #[path = "../../../tools/bench_cli.rs"]
 mod bench_cli;
+#[path = "../../../tools/copy_dir.rs"]
+mod copy_dir;
 use bench_cli::{mannequin, subject};
+use copy_dir::copy_dir;
 
 /// The time target for segmenting 120 frames, seconds.
 const SEGMENT_TARGET_S: f64 = 30.0;
@@ -97,19 +100,6 @@ fn other_size(size: &str) -> &'static str {
         "S" => "M",
         "M" => "L",
         _ => "M",
-    }
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_dir(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), target).unwrap();
-        }
     }
 }
 

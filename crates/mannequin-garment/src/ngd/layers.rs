@@ -24,7 +24,7 @@ pub fn resolve(spec: &str, data: &Path) -> Result<Vec<Category>, NgdError> {
         return Err(NgdError::file(
             data,
             format!(
-                "--garments reconstructs garments from label maps ({}/label_%04d.png, with subject.json's \"labels\" legend); add them, or train without --garments",
+                "--garments reconstructs garments from label maps ({}/label_%04d.png, with subject.json's \"labels\" legend); make them with `mannequin segment --data DATASET`, or train without --garments",
                 layout::LABELS
             ),
         ));

@@ -89,14 +89,7 @@ fn nearest_body_pixel(face: &[u32], mask: &[bool], width: usize, height: usize) 
         }
     }
     while let Some(i) = queue.pop_front() {
-        let (x, y) = (i % width, i / width);
-        let neighbours = [
-            (x > 0).then(|| i - 1),
-            (x + 1 < width).then(|| i + 1),
-            (y > 0).then(|| i - width),
-            (y + 1 < height).then(|| i + width),
-        ];
-        for n in neighbours.into_iter().flatten() {
+        for n in neighbours(i, width, height).into_iter().flatten() {
             if mask[n] && source[n] == NO_SOURCE {
                 source[n] = source[i];
                 queue.push_back(n);
@@ -104,6 +97,17 @@ fn nearest_body_pixel(face: &[u32], mask: &[bool], width: usize, height: usize) 
         }
     }
     source
+}
+
+/// The pixel's 4 neighbours on a `width` × `height` grid, `None` past the border.
+pub fn neighbours(i: usize, width: usize, height: usize) -> [Option<usize>; 4] {
+    let (x, y) = (i % width, i / width);
+    [
+        (x > 0).then(|| i - 1),
+        (x + 1 < width).then(|| i + 1),
+        (y > 0).then(|| i - width),
+        (y + 1 < height).then(|| i + width),
+    ]
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use mannequin_raster::hard::NO_FACE;
 
 use super::class::{CLASSES, Scores};
 use super::colour_model::ColourModel;
-use super::frame_view::{FrameView, NO_SOURCE};
+use super::frame_view::{FrameView, NO_SOURCE, neighbours};
 
 /// Mean-field iterations.
 const ITERATIONS: usize = 5;
@@ -64,14 +64,7 @@ fn mean_field(view: &FrameView, unary: &[Option<Scores>]) -> Vec<Option<Scores>>
         let next: Vec<Option<Scores>> = (0..w * h)
             .map(|i| {
                 let mut s = unary[i]?;
-                let (x, y) = (i % w, i / w);
-                let neighbours = [
-                    (x > 0).then(|| i - 1),
-                    (x + 1 < w).then(|| i + 1),
-                    (y > 0).then(|| i - w),
-                    (y + 1 < h).then(|| i + w),
-                ];
-                for j in neighbours.into_iter().flatten() {
+                for j in neighbours(i, w, h).into_iter().flatten() {
                     if let Some(qj) = q[j] {
                         let wij = weight(i, j);
                         s.iter_mut().zip(qj).for_each(|(a, b)| *a += wij * b);

@@ -71,10 +71,11 @@ impl Outfit {
         Ok((outfit, false))
     }
 
-    /// `auto`: one dress where the two garments' colours are alike; otherwise the sleeves' and
-    /// legs' lengths, and whether the lower garment spans the legs, name the categories.
+    /// `auto`: one dress where the two garments' colours are alike and the lower part spans the
+    /// legs (a suit is alike too, but has trouser legs); otherwise the sleeves' and legs'
+    /// lengths, and whether the lower garment spans the legs, name the categories.
     pub fn decide(e: &Evidence) -> Self {
-        if e.colour_overlap > DRESS_OVERLAP {
+        if e.colour_overlap > DRESS_OVERLAP && e.legs_joined > SKIRT_SPAN {
             return Outfit::Dress;
         }
         let upper = if e.forearms_covered > LONG_SLEEVE { Category::Shirt } else { Category::Tshirt };
@@ -130,7 +131,10 @@ mod tests {
 
     #[test]
     fn auto_reads_sleeves_legs_and_the_span_between_the_legs() {
-        assert_eq!(Outfit::decide(&evidence(0.9, 0.0, 0.0, 0.5)), Outfit::Dress);
+        assert_eq!(Outfit::decide(&evidence(0.9, 0.0, 0.0, 0.9)), Outfit::Dress);
+        // A suit: alike colours, trouser legs.
+        let o = Outfit::decide(&evidence(0.9, 0.9, 0.9, 0.2));
+        assert_eq!(o, Outfit::TwoPiece { upper: Category::Shirt, lower: Category::Pants });
         let o = Outfit::decide(&evidence(0.1, 0.1, 0.9, 0.8));
         assert_eq!(o, Outfit::TwoPiece { upper: Category::Tshirt, lower: Category::Pants });
         let o = Outfit::decide(&evidence(0.1, 0.1, 0.9, 0.99));
