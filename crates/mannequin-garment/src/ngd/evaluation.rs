@@ -1,6 +1,9 @@
 //! How close a reconstruction is to the dataset's ground-truth garment meshes, where it has them:
 //! Chamfer distance, point-to-surface distance and normal consistency, averaged over frames of
-//! the training and the test split.
+//! the training and the test split, and of a synthetic subject's novel poses (`test/novel_pose`:
+//! walking, raising and crossing the arms, squatting), which the fit never saw. Novel views
+//! would add nothing here: they show the training poses, whose geometry does not depend on the
+//! camera.
 
 use std::path::Path;
 
@@ -23,6 +26,7 @@ const EVALUATION_SAMPLES: usize = 20_000;
 pub(crate) struct SplitGeometry {
     pub train: GeometryMetrics,
     pub test: Option<GeometryMetrics>,
+    pub novel_pose: Option<GeometryMetrics>,
     pub frames: usize,
 }
 
@@ -31,27 +35,26 @@ pub(crate) struct SplitGeometry {
 pub(crate) struct Evaluation {
     train: Vec<(FramePose, TriMesh)>,
     test: Vec<(FramePose, TriMesh)>,
+    novel_pose: Vec<(FramePose, TriMesh)>,
 }
+
+/// Where a synthetic subject keeps its novel poses.
+const NOVEL_POSE: &str = "test/novel_pose";
 
 impl Evaluation {
     /// The ground truth of `category` in the dataset at `root`; none where a frame lacks it.
     pub fn new(root: &Path, dataset: &Dataset, category: &str) -> Result<Self, NgdError> {
-        let read = |name: &str| -> Result<Vec<(FramePose, TriMesh)>, NgdError> {
-            let Ok(split) = dataset.split(name) else { return Ok(Vec::new()) };
-            let stride = split.frames.len().div_ceil(EVALUATED_FRAMES).max(1);
-            let mut out = Vec::new();
-            for k in (0..split.frames.len()).step_by(stride) {
-                let path = layout::garment_mesh(root, category, split.frames[k]);
-                if !path.exists() {
-                    return Ok(Vec::new());
-                }
-                let mesh = mannequin_mesh::ply::read(&path)
-                    .map_err(|source| NgdError::ReadMesh { path: path.clone(), source })?;
-                out.push((FramePose::of(&split, k), mesh.mesh));
-            }
-            Ok(out)
+        let novel = root.join(NOVEL_POSE);
+        let novel_pose = if novel.join(layout::MESHES).is_dir() {
+            truth(&novel, &Dataset::open(&novel, dataset.downscale)?, "test", category)?
+        } else {
+            Vec::new()
         };
-        Ok(Self { train: read("train")?, test: read("test")? })
+        Ok(Self {
+            train: truth(root, dataset, "train", category)?,
+            test: truth(root, dataset, "test", category)?,
+            novel_pose,
+        })
     }
 
     /// The fit's current metrics, or None without ground truth.
@@ -70,6 +73,34 @@ impl Evaluation {
             Ok(Some(sum))
         };
         let Some(train) = over(&self.train)? else { return Ok(None) };
-        Ok(Some(SplitGeometry { train, test: over(&self.test)?, frames: self.train.len() + self.test.len() }))
+        Ok(Some(SplitGeometry {
+            train,
+            test: over(&self.test)?,
+            novel_pose: over(&self.novel_pose)?,
+            frames: self.train.len() + self.test.len() + self.novel_pose.len(),
+        }))
     }
+}
+
+/// The ground truth of `category` on up to [`EVALUATED_FRAMES`] frames evenly spread through the
+/// split `name` of the dataset at `root`; none where the split or a frame's mesh is missing.
+fn truth(
+    root: &Path,
+    dataset: &Dataset,
+    name: &str,
+    category: &str,
+) -> Result<Vec<(FramePose, TriMesh)>, NgdError> {
+    let Ok(split) = dataset.split(name) else { return Ok(Vec::new()) };
+    let stride = split.frames.len().div_ceil(EVALUATED_FRAMES).max(1);
+    let mut out = Vec::new();
+    for k in (0..split.frames.len()).step_by(stride) {
+        let path = layout::garment_mesh(root, category, split.frames[k]);
+        if !path.exists() {
+            return Ok(Vec::new());
+        }
+        let mesh = mannequin_mesh::ply::read(&path)
+            .map_err(|source| NgdError::ReadMesh { path: path.clone(), source })?;
+        out.push((FramePose::of(&split, k), mesh.mesh));
+    }
+    Ok(out)
 }

@@ -19,12 +19,16 @@ pub enum Part {
     Crown,
     /// Neck and collar bones.
     Neck,
+    /// The upper chest, up to the neckline.
     Chest,
+    /// From below the chest to the waist.
     Belly,
     Pelvis,
     UpperArm,
     Forearm,
     Hand,
+    /// The top of the thighs, where a loose top's hem hangs over the trousers.
+    Hip,
     Thigh,
     Shin,
     Foot,
@@ -40,14 +44,18 @@ impl Part {
             Part::Face => (&[Skin], &[Hair]),
             Part::Crown => (&[Hair], &[Skin]),
             Part::Neck => (&[Skin, Upper], &[Hair]),
-            Part::Chest | Part::Belly => (&[Upper], &[Lower, Skin, Hair]),
+            // A neckline, or a top slipping off the shoulder, shows the upper chest's skin.
+            Part::Chest => (&[Upper, Skin], &[Hair]),
+            Part::Belly => (&[Upper], &[Lower, Skin, Hair]),
             Part::Pelvis => (&[Upper, Lower], &[Skin]),
             Part::UpperArm => (&[Upper, Skin], &[Hair]),
             Part::Forearm => (&[Skin, Upper], &[]),
             Part::Hand => (&[Skin], &[Upper]),
+            Part::Hip => (&[Lower, Upper], &[Skin]),
             Part::Thigh => (&[Lower, Skin], &[Upper]),
             Part::Shin => (&[Lower, Skin], &[Shoes]),
-            Part::Foot => (&[Shoes], &[Skin, Lower]),
+            // Trouser hems fall over the shoes.
+            Part::Foot => (&[Shoes, Lower], &[Skin]),
         };
         let mut prior = [NEVER; CLASSES];
         expected.iter().for_each(|c| prior[c.index()] = 0.0);
@@ -60,13 +68,16 @@ impl Part {
         match self {
             Part::Face | Part::Hand => Some(Class::Skin),
             Part::Crown => Some(Class::Hair),
-            Part::Chest | Part::Belly => Some(Class::Upper),
+            Part::Belly => Some(Class::Upper),
             Part::Thigh => Some(Class::Lower),
             Part::Foot => Some(Class::Shoes),
             _ => None,
         }
     }
 }
+
+/// The share of the thigh, from the hip joint down to the knee, that counts as the hip.
+const HIP_SHARE: f32 = 0.3;
 
 /// Log prior of a class a part rarely shows.
 pub const UNLIKELY: f32 = -3.0;
@@ -78,6 +89,8 @@ pub const NEVER: f32 = -10.0;
 pub fn vertex_parts(model: &BodyModel, rest: &[[f32; 3]], joints: &[[f32; 3]]) -> Vec<Part> {
     let n = model.num_joints();
     let head = joints[j::HEAD];
+    let (hip, knee) = (joints[j::L_HIP][1], joints[j::L_KNEE][1]);
+    let hip_line = hip - HIP_SHARE * (hip - knee);
     rest.iter()
         .enumerate()
         .map(|(v, p)| {
@@ -92,12 +105,13 @@ pub fn vertex_parts(model: &BodyModel, rest: &[[f32; 3]], joints: &[[f32; 3]]) -
                 j::HEAD if p[2] > head[2] + 0.03 && p[1] < head[1] + 0.04 => Part::Face,
                 j::HEAD => Part::Head,
                 j::NECK | j::L_COLLAR | j::R_COLLAR => Part::Neck,
-                j::SPINE3 | j::SPINE2 => Part::Chest,
-                j::SPINE1 => Part::Belly,
+                j::SPINE3 => Part::Chest,
+                j::SPINE2 | j::SPINE1 => Part::Belly,
                 j::PELVIS => Part::Pelvis,
                 j::L_SHOULDER | j::R_SHOULDER => Part::UpperArm,
                 j::L_ELBOW | j::R_ELBOW => Part::Forearm,
                 j::L_WRIST | j::R_WRIST | j::L_HAND | j::R_HAND => Part::Hand,
+                j::L_HIP | j::R_HIP if p[1] > hip_line => Part::Hip,
                 j::L_HIP | j::R_HIP => Part::Thigh,
                 j::L_KNEE | j::R_KNEE => Part::Shin,
                 j::L_ANKLE | j::R_ANKLE | j::L_FOOT | j::R_FOOT => Part::Foot,

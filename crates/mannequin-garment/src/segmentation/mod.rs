@@ -112,7 +112,8 @@ pub fn segment(
             .map(|t| {
                 let p = rest[t[0] as usize];
                 let mid_thigh = 0.5 * (joints[L_HIP][1] + joints[L_KNEE][1]);
-                (parts[t[0] as usize] == Part::Thigh && p[1] > mid_thigh).then_some(p[0] >= 0.0)
+                let thigh = matches!(parts[t[0] as usize], Part::Hip | Part::Thigh);
+                (thigh && p[1] > mid_thigh).then_some(p[0] >= 0.0)
             })
             .collect(),
     };
