@@ -50,7 +50,8 @@ enum Command {
     /// simulation, as a glTF scene, point caches, rendered frames and metrics.
     Dress(dress::Args),
     /// A person's own video (or frames) to a dataset `train` reads: landmarks and masks by the
-    /// shipped person models, one body shape, a pose per frame, one static camera.
+    /// shipped person models, one body shape, a pose per frame, one static camera, and garment
+    /// labels (`segment`).
     Capture(capture::Args),
     /// Garment labels from a dataset's images, person masks and poses alone (`auto` decides the
     /// garments): labels/, hands/ and the legend, as `garment fit` and `train --garments` read them.

@@ -10,7 +10,7 @@ use crate::ngd::NgdError;
 #[serde(deny_unknown_fields)]
 pub struct SegmentSettings {
     /// The garments worn: `auto` decides them from the images (sleeve length, whether the lower
-    /// garment reaches the ankles or spans the legs, one dress where top and bottom are alike);
+    /// garment reaches the ankles or spans the legs, one dress where top and bottom are alike and join the legs);
     /// or name them: `dress`, or `upper:tshirt,lower:pants`.
     #[arg(long = "garments", default_value_t = SegmentSettings::default().garments)]
     pub garments: String,
