@@ -14,6 +14,8 @@ use super::remesh::RemeshSchedule;
 
 /// The normal loss's weight where the dataset has normal maps.
 const DEFAULT_NORMAL_WEIGHT: f64 = 2.0;
+/// The vertex noise γ (metres) of a fit to the label maps alone.
+const MASKS_ALONE_NOISE: f64 = 0.01;
 
 /// How a garment is reconstructed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, clap::Args)]
@@ -34,8 +36,10 @@ pub struct NgdSettings {
     pub regulariser: f64,
     /// NGD's vertex noise (Eqs. 11–12): each step's posed vertices move by γ N(0, 1) (1 − e/T)
     /// at step e of T, so early steps see the garment's overall shape; γ in metres (0: none).
-    #[arg(long = "noise", default_value_t = NgdSettings::default().noise)]
-    pub noise: f64,
+    /// Without it: none where the normal loss is on, 1 cm where the fit reads the label maps
+    /// alone (docs/ngd.md).
+    #[arg(long = "noise")]
+    pub noise: Option<f64>,
     /// The weight of the normal-map loss (Huber, on the garment's pixels) against the mask loss;
     /// 0 fits the masks alone. Without it: 2 where the dataset has normal maps, else 0.
     #[arg(long = "normal-weight")]
@@ -53,9 +57,10 @@ pub struct NgdSettings {
     #[arg(long = "network-rate", default_value_t = NgdSettings::default().network_rate)]
     pub network_rate: f64,
     /// Steps between NGD's adaptive remeshings (§3.2: the faces with the largest gradients are
-    /// split, finer as the fit goes); 0: none.
-    #[arg(long = "remesh-every", default_value_t = NgdSettings::default().remesh_every)]
-    pub remesh_every: usize,
+    /// split, finer as the fit goes); 0: none. Without it: every 100 steps where the normal loss
+    /// is on, none where the fit reads the label maps alone (docs/ngd.md).
+    #[arg(long = "remesh-every")]
+    pub remesh_every: Option<usize>,
     /// Images are read at 1/N of their size.
     #[arg(long = "downscale", default_value_t = NgdSettings::default().downscale)]
     pub downscale: usize,
@@ -72,12 +77,12 @@ impl Default for NgdSettings {
             steps: 400,
             rate: 0.01,
             regulariser: 0.0,
-            noise: 0.0,
+            noise: None,
             normal_weight: None,
             ssim_weight: 0.0,
             pose_components: dynamic.components,
             network_rate: dynamic.rate,
-            remesh_every: RemeshSchedule::default().every,
+            remesh_every: None,
             downscale: 2,
             seed: 0,
         }
@@ -110,17 +115,23 @@ impl NgdSettings {
                 0.0
             }
         };
+        // Fitted to silhouettes alone, remeshing splits faces where the label maps' edges pull,
+        // which roughens the surface, and early noise keeps the fit to the garment's overall
+        // shape: both measured on a tuning subject (docs/ngd.md).
+        let masks_alone = normal_weight == 0.0;
+        let noise = self.noise.unwrap_or(if masks_alone { MASKS_ALONE_NOISE } else { 0.0 });
+        let remesh_every =
+            self.remesh_every.unwrap_or(if masks_alone { 0 } else { RemeshSchedule::default().every });
         Ok(Settings {
             steps: self.steps,
             rate: self.rate,
             regulariser: self.regulariser,
-            noise: self.noise,
+            noise,
             normal_weight,
             ssim_weight: if normal_weight > 0.0 { self.ssim_weight } else { 0.0 },
             dynamic: (self.pose_components > 0)
                 .then_some(DynamicSettings { components: self.pose_components, rate: self.network_rate }),
-            remesh: (self.remesh_every > 0)
-                .then(|| RemeshSchedule { every: self.remesh_every, ..Default::default() }),
+            remesh: (remesh_every > 0).then(|| RemeshSchedule { every: remesh_every, ..Default::default() }),
             seed: self.seed,
         })
     }
