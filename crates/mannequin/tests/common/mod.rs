@@ -91,4 +91,5 @@ pub fn read_json(path: &Path) -> serde_json::Value {
 
 #[path = "../../../../tools/copy_dir.rs"]
 mod copy_dir_tool;
+#[allow(unused_imports)] // not every test binary copies folders
 pub use copy_dir_tool::copy_dir;
