@@ -64,8 +64,6 @@ pub struct Segmented {
     pub evidence: Evidence,
     pub frames: usize,
     pub seconds: f64,
-    #[serde(skip)]
-    pub outfit: Option<Outfit>,
 }
 
 /// Labels every frame of the dataset at `data` (posed with the body model `body`), writing
@@ -197,7 +195,6 @@ pub fn segment(
         evidence,
         frames: poses.len(),
         seconds: start.elapsed().as_secs_f64(),
-        outfit: Some(outfit),
     };
     let record = serde_json::json!({ "garments": settings.garments, "result": &done });
     let path = stage_labels.path().join("segmentation.json");
