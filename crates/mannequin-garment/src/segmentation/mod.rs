@@ -16,6 +16,7 @@ mod labelling;
 mod outfit;
 mod settings;
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
@@ -94,9 +95,8 @@ pub fn segment(
         ));
     }
     let dataset = Dataset::open(data, 1)?;
-    let poses = frame_poses(&dataset)?;
+    let (poses, betas) = frame_poses(&dataset)?;
     let model = load_body(body)?;
-    let betas = dataset.split(poses[0].split.as_str())?.poses.betas;
     let shaped = shape_body(&model, &betas)?;
     let rest: Vec<[f32; 3]> = shaped.vertices.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     let joints: Vec<[f32; 3]> = shaped.joints.iter().map(|j| j.to_array()).collect();
@@ -118,6 +118,8 @@ pub fn segment(
     let face_part = |f: u32| body.part[f as usize];
 
     let progress = bar(3 * poses.len() as u64, "segment");
+    // Each pass reads and draws its frames again (all three take 5–6 s for 120 frames at 540²)
+    // rather than hold 120 frames of images, masks, face ids and barycentrics (about 1 GB).
     let view = |p: &PoseOfFrame| {
         let pose = FramePose { pose: &p.pose, transl: p.transl };
         let v = FrameView::new(&dataset, p.frame, &model, &shaped, &pose);
@@ -209,32 +211,32 @@ pub fn segment(
 /// One frame to label and its body pose.
 struct PoseOfFrame {
     frame: usize,
-    split: String,
     pose: Vec<f32>,
     transl: [f32; 3],
 }
 
-/// Every frame of the dataset's splits with its pose, once each, in frame order.
-fn frame_poses(dataset: &Dataset) -> Result<Vec<PoseOfFrame>, NgdError> {
-    let mut out: Vec<PoseOfFrame> = Vec::new();
+/// Every frame of the dataset's splits with its pose, once each, in frame order, and the body's
+/// shape (one for the whole capture).
+fn frame_poses(dataset: &Dataset) -> Result<(Vec<PoseOfFrame>, Vec<f32>), NgdError> {
+    let mut frames: BTreeMap<usize, PoseOfFrame> = BTreeMap::new();
+    let mut betas = None;
     for name in dataset.splits.keys() {
         let split = dataset.split(name)?;
         for (k, &frame) in split.frames.iter().enumerate() {
-            if !out.iter().any(|p| p.frame == frame) {
-                out.push(PoseOfFrame {
-                    frame,
-                    split: name.clone(),
-                    pose: split.poses.pose72(k),
-                    transl: split.poses.transl[k],
-                });
-            }
+            frames.entry(frame).or_insert_with(|| PoseOfFrame {
+                frame,
+                pose: split.poses.pose72(k),
+                transl: split.poses.transl[k],
+            });
+        }
+        if !split.frames.is_empty() {
+            betas.get_or_insert(split.poses.betas);
         }
     }
-    if out.is_empty() {
-        return Err(NgdError::file(dataset.root.join(layout::SPLITS), "no split has frames to segment"));
+    match betas {
+        Some(betas) => Ok((frames.into_values().collect(), betas)),
+        None => Err(NgdError::file(dataset.root.join(layout::SPLITS), "no split has frames to segment")),
     }
-    out.sort_by_key(|p| p.frame);
-    Ok(out)
 }
 
 fn empty_models() -> Vec<ColourModel> {

@@ -23,7 +23,7 @@ pub const SKIRT_SPAN: f64 = 0.5;
 pub const LONG_SKIRT_SPAN: f64 = 0.95;
 
 /// What the clip showed that the decision reads.
-#[derive(Debug, Clone, Copy, Default, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize)]
 pub struct Evidence {
     /// Bhattacharyya coefficient of the upper and lower garments' colours.
     pub colour_overlap: f64,
@@ -47,28 +47,28 @@ pub enum Outfit {
 pub const BODY_LABELS: [&str; 4] = ["background", "skin", "hair", "shoes"];
 
 impl Outfit {
-    /// The outfit `spec` names (`auto` decides it from `evidence`).
+    /// The outfit `spec` names (`auto` decides it from `evidence`), and whether it was decided.
     pub fn choose(spec: &str, evidence: &Evidence) -> Result<(Self, bool), NgdError> {
-        if spec == "auto" {
-            return Ok((Self::decide(evidence), true));
-        }
+        if spec == "auto" { Ok((Self::decide(evidence), true)) } else { Ok((Self::named(spec)?, false)) }
+    }
+
+    /// The outfit a `--garments` value other than `auto` names: a dress alone, or one upper and
+    /// one lower garment.
+    pub fn named(spec: &str) -> Result<Self, NgdError> {
         let named: Vec<Category> = spec.split(',').map(|i| parse_item(i.trim())).collect::<Result<_, _>>()?;
-        let outfit = match named.as_slice() {
-            [Category::Dress] => Outfit::Dress,
+        match named.as_slice() {
+            [Category::Dress] => Ok(Outfit::Dress),
             [a, b] if a.is_lower_body() != b.is_lower_body() && !named.contains(&Category::Dress) => {
                 let (upper, lower) = if a.is_lower_body() { (*b, *a) } else { (*a, *b) };
-                Outfit::TwoPiece { upper, lower }
+                Ok(Outfit::TwoPiece { upper, lower })
             }
-            _ => {
-                return Err(NgdError::flag(
-                    "--garments",
-                    format!(
-                        "'{spec}': name a dress alone, or one upper and one lower garment (upper:tshirt,lower:pants), or auto"
-                    ),
-                ));
-            }
-        };
-        Ok((outfit, false))
+            _ => Err(NgdError::flag(
+                "--garments",
+                format!(
+                    "'{spec}': name a dress alone, or one upper and one lower garment (upper:tshirt,lower:pants), or auto"
+                ),
+            )),
+        }
     }
 
     /// `auto`: one dress where the two garments' colours are alike and the lower part spans the

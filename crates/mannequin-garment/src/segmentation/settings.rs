@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::outfit::{Evidence, Outfit};
+use super::outfit::Outfit;
 use crate::ngd::NgdError;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, clap::Args)]
@@ -26,7 +26,7 @@ impl SegmentSettings {
     /// Refuses a `--garments` that names no outfit, before any work.
     pub fn check(&self) -> Result<(), NgdError> {
         if self.garments != "auto" {
-            Outfit::choose(&self.garments, &Evidence::default())?;
+            Outfit::named(&self.garments)?;
         }
         Ok(())
     }
