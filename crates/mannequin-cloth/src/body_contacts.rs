@@ -123,12 +123,6 @@ impl BodyCollider {
         }));
     }
 
-    /// The body's mean displacement over the current substep: its bulk motion.
-    pub fn mean_step(&self) -> Vec3 {
-        let total: Vec3 = self.now.iter().zip(&self.before).map(|(a, b)| *a - *b).sum();
-        total / self.now.len().max(1) as f32
-    }
-
     /// Rebuilds the hash when substep `k` starts a new window; says whether it did.
     pub fn rebuild_if_due(&mut self, k: u32) -> bool {
         if k < self.window_end {

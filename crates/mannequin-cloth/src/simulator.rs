@@ -53,9 +53,6 @@ impl Simulator {
         for a in &attachments {
             inverse_mass[a.particle as usize] = 0.0;
         }
-        if settings.self_collision {
-            check_uncrossed(&cloth.start, &cloth.faces)?;
-        }
         let anchors: Vec<u32> = attachments.iter().map(|a| a.particle).collect();
         let tethers = if anchors.is_empty() {
             Tethers::default()
@@ -104,7 +101,7 @@ impl Simulator {
             }
         }
         if let Some(contacts) = &mut self.contacts {
-            contacts.begin_frame();
+            contacts.begin_frame(self.body.as_ref().map_or(0.0, |b| b.step));
         }
         let dt = frame_dt / substeps as f32;
         for k in 0..substeps {
@@ -128,10 +125,13 @@ impl Simulator {
         }
         let t = Instant::now();
         self.predict(dt);
+        if let Some(contacts) = &self.contacts {
+            contacts.bound_displacements(&mut self.positions, &self.previous, &self.inverse_mass);
+        }
         self.times.prediction += t.elapsed();
         if let Some(contacts) = &mut self.contacts {
             let t = Instant::now();
-            contacts.begin_substep(&self.previous, &self.cloth.faces);
+            contacts.refresh(&self.positions, &self.previous, &self.cloth.faces);
             self.times.hashing += t.elapsed();
         }
         self.stretch_lambda.fill(0.0);
@@ -141,31 +141,23 @@ impl Simulator {
             let t = Instant::now();
             self.cloth.stretch.project(&mut self.positions, w, &mut self.stretch_lambda, dt);
             self.tethers.project(&mut self.positions, w);
-            // Before the body and the contacts, which have the last word on where cloth may be.
-            let limit = self.cloth.material.strain_limit;
-            self.cloth.stretch.limit_strain(&mut self.positions, w, limit, &mut self.stretch_lambda);
             self.times.stretch += t.elapsed();
             let t = Instant::now();
             self.cloth.bending.project(&mut self.positions, w, &mut self.bending_lambda, dt);
             self.times.bending += t.elapsed();
+            if let Some(contacts) = &mut self.contacts {
+                let t = Instant::now();
+                contacts.project(&mut self.positions, &self.previous, w, &self.cloth.faces);
+                self.times.self_contacts += t.elapsed();
+            }
             if let Some(body) = &self.body {
                 let t = Instant::now();
                 let (margin, friction) = (self.settings.body_margin, self.cloth.material.friction);
                 body.project(&mut self.positions, &self.previous, w, margin, friction);
                 self.times.body_contacts += t.elapsed();
             }
-            // Last, so the body's push does not undo them: what they leave undone the bounds hold.
-            if let Some(contacts) = &self.contacts {
-                let t = Instant::now();
-                contacts.project(&mut self.positions, &self.previous, w, &self.cloth.faces);
-                self.times.self_contacts += t.elapsed();
-            }
         }
         let t = Instant::now();
-        if let Some(contacts) = &self.contacts {
-            let common = self.body.as_ref().map_or(Vec3::ZERO, BodyCollider::mean_step);
-            contacts.end_substep(&mut self.positions, &self.previous, &self.inverse_mass, common);
-        }
         self.update_velocities(dt);
         self.times.prediction += t.elapsed();
     }
@@ -232,16 +224,4 @@ impl Simulator {
         self.velocities = state.velocities;
         Ok(())
     }
-}
-
-/// Refuses a start where the cloth crosses itself, with the count and the place of the first
-/// crossing: the displacement bounds would hold such a pair crossed for ever.
-fn check_uncrossed(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Result<(), ClothError> {
-    let crossed = crate::quality::self_intersections(positions, faces);
-    let Some(&[first, second]) = crossed.first() else {
-        return Ok(());
-    };
-    let corners = faces[first].iter().chain(&faces[second]).map(|&v| Vec3::from(positions[v as usize]));
-    let [x, y, z] = (corners.sum::<Vec3>() / 6.0).to_array();
-    Err(ClothError::StartsCrossed { pairs: crossed.len(), first, second, x, y, z })
 }

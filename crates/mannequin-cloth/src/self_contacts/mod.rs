@@ -1,18 +1,18 @@
 //! Self-collision: vertex–triangle contacts (Eq. 3.22) and edge–edge contacts, each keeping the
-//! thickness h between the cloth's layers on the side each pair was on at the start of the
-//! substep, and displacement bounds that keep any pair from passing through in between.
+//! thickness h between the cloth's layers, on the side each pair was on at the start of the
+//! substep unless it got there without passing through.
 //!
 //! Candidate pairs come from spatial hashes of boxes inflated by h + s, rebuilt at the start of
-//! every frame and again whenever the cloth has moved enough, relative to itself, that a pair left
-//! out could have come within h. Every pair within reach at the start of a substep, and the
-//! nearest a left-out pair can be, bound how far each particle may move in it. Nothing is
-//! remembered from one frame to the next, so a saved state of positions and velocities resumes
-//! the same run.
+//! every frame and again whenever the cloth has moved enough that a pair left out could have come
+//! within h. The slack s bounds, between rebuilds, how far any two particles may move relative to
+//! each other (relative to the common motion, so a garment carried fast by the body is not held
+//! back): each substep's displacements are clamped to stay within reach of their common centre,
+//! and the rebuild check watches the displacement since the last rebuild. Nothing is remembered
+//! from one frame to the next, so a saved state of positions and velocities resumes the same run.
 
-mod displacement_bounds;
+mod crossing;
 mod edge_edge;
 mod neighbours;
-mod orientation;
 mod push;
 mod vertex_triangle;
 
@@ -20,27 +20,28 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::box_hash::Aabb;
-use displacement_bounds::DisplacementBounds;
 use edge_edge::EdgeEdge;
 use neighbours::Neighbours;
 use push::Reach;
 use vertex_triangle::VertexTriangle;
 
-/// The slack s is this many thicknesses: a wider reach rebuilds less often but holds more pairs.
-const THICKNESS_SLACK: f32 = 1.0;
-/// The candidates are rebuilt once the cloth has moved, relative to itself, this share of the
-/// slack: a left-out pair is then still farther than h.
+/// The slack s per frame is this many thicknesses, plus [`BODY_SLACK`] times the body's travel per
+/// substep (the body can push two particles apart by that much within one substep).
+const THICKNESS_SLACK: f32 = 2.0;
+const BODY_SLACK: f32 = 4.0;
+/// Of the slack, this share bounds the clamped prediction and the body's push; the rest covers
+/// the small moves of the other constraints.
 const SLACK_USE: f32 = 0.9;
-
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct SelfContacts {
     neighbours: Neighbours,
     edges: Vec<[u32; 2]>,
     vertex_triangle: VertexTriangle,
     edge_edge: EdgeEdge,
-    bounds: DisplacementBounds,
     thickness: f32,
     slack: f32,
+    /// The body's travel per substep in this frame.
+    body_step: f32,
     /// Positions at the last rebuild.
     reference: Vec<[f32; 3]>,
     stale: bool,
@@ -53,41 +54,65 @@ impl SelfContacts {
             edges,
             vertex_triangle: VertexTriangle::default(),
             edge_edge: EdgeEdge::default(),
-            bounds: DisplacementBounds::default(),
             thickness,
             slack: THICKNESS_SLACK * thickness,
+            body_step: 0.0,
             reference: Vec::new(),
             stale: true,
         }
     }
 
-    /// Starts a frame: the candidates are rebuilt at its first substep.
-    pub fn begin_frame(&mut self) {
+    /// Starts a frame in which the body moves up to `body_step` per substep: the slack grows with
+    /// it, and the candidates are rebuilt at the first substep with fresh sides.
+    pub fn begin_frame(&mut self, body_step: f32) {
+        self.body_step = body_step;
+        self.slack = THICKNESS_SLACK * self.thickness + BODY_SLACK * body_step;
         self.stale = true;
     }
 
-    /// Starts a substep from `previous` (the last resolved positions): rebuilds the candidates if the frame just began or the cloth has moved too far
-    /// since, and bounds every particle's move.
-    pub fn begin_substep(&mut self, previous: &[[f32; 3]], faces: &[[u32; 3]]) {
-        let reach = Reach { distance: self.thickness + self.slack, thickness: self.thickness };
-        let mut moved = match self.stale {
-            true => f32::INFINITY,
-            false => spread(previous, &self.reference).extent().length(),
-        };
-        if moved > SLACK_USE * self.slack {
-            self.vertex_triangle.rebuild(previous, faces, reach, &self.neighbours);
-            self.edge_edge.rebuild(previous, &self.edges, reach, &self.neighbours);
-            self.reference.clear();
-            self.reference.extend_from_slice(previous);
-            self.stale = false;
-            moved = 0.0;
-        } else {
-            self.vertex_triangle.measure(previous, faces);
-            self.edge_edge.measure(previous, &self.edges);
+    /// Clamps this substep's predicted displacements (free particles only) to within d of their
+    /// common centre on each axis, with d chosen so that, with the body's push, no two particles
+    /// close by more than the slack in one substep.
+    pub fn bound_displacements(
+        &self,
+        positions: &mut [[f32; 3]],
+        previous: &[[f32; 3]],
+        inverse_mass: &[f32],
+    ) {
+        let limit = self.budget() / (2.0 * 3f32.sqrt());
+        let moved = spread(positions, previous);
+        if moved.extent().max_element() <= 2.0 * limit {
+            return;
         }
-        self.bounds.begin(previous, reach.distance - moved);
-        self.vertex_triangle.meet(faces, &self.bounds);
-        self.edge_edge.meet(&self.edges, &self.bounds);
+        let centre = 0.5 * (moved.min + moved.max);
+        let (lo, hi) = (centre - limit, centre + limit);
+        (positions, previous, inverse_mass).into_par_iter().for_each(|(x, p, &w)| {
+            if w > 0.0 {
+                let p = Vec3::from(*p);
+                *x = (p + (Vec3::from(*x) - p).clamp(lo, hi)).to_array();
+            }
+        });
+    }
+
+    /// Rebuilds the candidates from `previous` (the last resolved positions) if the frame just
+    /// began or if the motion since the last rebuild, up to `positions`, could have brought a
+    /// left-out pair within h.
+    pub fn refresh(&mut self, positions: &[[f32; 3]], previous: &[[f32; 3]], faces: &[[u32; 3]]) {
+        if !self.stale && spread(positions, &self.reference).extent().length() <= self.budget() {
+            return;
+        }
+        let reach = Reach { distance: self.thickness + self.slack, thickness: self.thickness };
+        self.vertex_triangle.rebuild(previous, faces, reach, &self.neighbours);
+        self.edge_edge.rebuild(previous, &self.edges, reach, &self.neighbours);
+        self.reference.clear();
+        self.reference.extend_from_slice(previous);
+        self.stale = false;
+    }
+
+    /// How far two particles may close between rebuilds, besides the body's push and the other
+    /// constraints' moves.
+    fn budget(&self) -> f32 {
+        SLACK_USE * self.slack - 2.0 * self.body_step
     }
 
     /// One pass over the vertex–triangle pairs, then one over the edge–edge pairs. A pair deeper
@@ -102,18 +127,6 @@ impl SelfContacts {
     ) {
         self.vertex_triangle.project(positions, previous, inverse_mass, faces, self.thickness);
         self.edge_edge.project(positions, previous, inverse_mass, &self.edges, self.thickness);
-    }
-
-    /// Ends the substep: each free particle's move, less the `common` motion, is pulled back
-    /// within its bound.
-    pub fn end_substep(
-        &self,
-        positions: &mut [[f32; 3]],
-        previous: &[[f32; 3]],
-        inverse_mass: &[f32],
-        common: Vec3,
-    ) {
-        self.bounds.limit(positions, previous, inverse_mass, common);
     }
 }
 

@@ -52,12 +52,3 @@ pub(super) fn push_apart(
         *p = (Vec3::from(*p) + moves[k] * push).to_array();
     }
 }
-
-/// The farthest any of `particles` has moved from `previous`: a pair can be no nearer than at
-/// the start of the substep less its two sides' farthest moves.
-pub(super) fn moved(positions: &[[f32; 3]], previous: &[[f32; 3]], particles: &[u32]) -> f32 {
-    particles
-        .iter()
-        .map(|&i| Vec3::from(positions[i as usize]).distance(Vec3::from(previous[i as usize])))
-        .fold(0.0, f32::max)
-}
