@@ -37,7 +37,8 @@ pub use material::{MATERIAL_NAMES, Material};
 pub use phase_times::PhaseTimes;
 pub use settings::{SUBSTEPS, SUBSTEPS_TUNED_FPS, Settings};
 pub use simulate::{
-    Performer, SETTLE_SECONDS, SimulateJob, SimulateSettings, Simulation, Stepping, simulate,
+    GarmentInput, Performer, Pins, SETTLE_SECONDS, SimulateJob, SimulateSettings, Simulation, Stepping,
+    simulate,
 };
 pub use simulate_error::SimulateError;
 pub use simulator::Simulator;

@@ -7,6 +7,7 @@
 use glam::{Mat3A, Vec3A};
 use mannequin_body::weight_transfer::{KernelWidth, transfer_weights};
 use mannequin_body::{BodyModel, ShapedBody, frame_skinning, pose_corrected, shape_body};
+use mannequin_mesh::adjacency::boundary_loops_by_height;
 use mannequin_mesh::points;
 
 use crate::error::GarmentError;
@@ -61,6 +62,16 @@ impl<'a> Dressed<'a> {
     /// Eq. 3.2 at rest (θ = 0): I^g T(β, 0) + D^g.
     pub fn rest(&self) -> Vec<[f32; 3]> {
         self.garment.on_body(&points(&self.shaped.vertices), &self.faces)
+    }
+
+    /// The vertices held to the body, as an elastic waistband holds a skirt or trousers: for a
+    /// lower-body garment the loop of its boundary that is highest at rest, none otherwise.
+    pub fn held(&self) -> Vec<u32> {
+        let garment = self.garment;
+        match garment.recipe.category.is_lower_body() {
+            true => boundary_loops_by_height(&self.rest(), &garment.mesh.faces).pop().unwrap_or_default(),
+            false => Vec::new(),
+        }
     }
 
     /// `rest` (positions of the garment's vertices on this body at rest, e.g. a reconstruction's)

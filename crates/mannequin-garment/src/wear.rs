@@ -6,8 +6,6 @@
 
 use mannequin_body::Settling;
 use mannequin_cloth::{Attachment, Body, Cloth, ClothState, PhaseTimes, Settings, Simulator};
-use mannequin_mesh::TriMesh;
-use mannequin_mesh::adjacency::boundary_loops_by_height;
 
 use crate::collider::{Collider, Layer};
 use crate::error::GarmentError;
@@ -145,9 +143,8 @@ impl WearProgress {
 /// Called after each frame of a layer with its frames so far and the simulator.
 type LayerReport<'a, E> = dyn FnMut(&[Vec<[f32; 3]>], &Simulator) -> Result<(), E> + 'a;
 
-/// One layer through the whole schedule (settling included), or its rest from `resume`. Lower-
-/// body garments are held at the waist (the loop of their boundary that is highest at rest), as
-/// an elastic waistband holds them.
+/// One layer through the whole schedule (settling included), or its rest from `resume`, held
+/// where [`Dressed::held`] says.
 fn simulate_layer<E: From<GarmentError>>(
     name: &str,
     dressed: &Dressed,
@@ -177,14 +174,11 @@ fn simulate_layer<E: From<GarmentError>>(
     let collider = Collider::new(wearer.frames, wearer.faces, inner, &skinned);
     let faces = collider.faces.clone();
     let at_rest = collider.at(0);
-    let attachments: Vec<Attachment> = if garment.recipe.category.is_lower_body() {
-        waist_loop(&mesh)
-            .into_iter()
-            .map(|v| Attachment::bind(&at_rest, &faces, v, mesh.positions[v as usize]))
-            .collect()
-    } else {
-        Vec::new()
-    };
+    let attachments: Vec<Attachment> = dressed
+        .held()
+        .into_iter()
+        .map(|v| Attachment::bind(&at_rest, &faces, v, mesh.positions[v as usize]))
+        .collect();
     let mut sim = Simulator::new(cloth, Some(Body::new(faces)), attachments, settings)
         .map_err(failed("at rest".into()))?;
     let settle = wearer.schedule.settle;
@@ -208,9 +202,4 @@ fn simulate_layer<E: From<GarmentError>>(
         on_frame(&frames, &sim)?;
     }
     Ok(WornLayer { frames, phases: sim.phase_times() })
-}
-
-/// The vertices of the boundary loop whose mean height at rest is greatest.
-fn waist_loop(mesh: &TriMesh) -> Vec<u32> {
-    boundary_loops_by_height(&mesh.positions, &mesh.faces).pop().unwrap_or_default()
 }

@@ -21,6 +21,7 @@ use mannequin_mesh::{TriMesh, points, read_obj};
 use crate::attachment::Attachment;
 use crate::body::Body;
 use crate::cloth::Cloth;
+use crate::material::Material;
 use crate::phase_times::PhaseTimes;
 use crate::run_checkpoint::{CHECKPOINT, file_hash};
 use crate::settings::Settings;
@@ -29,18 +30,48 @@ use crate::simulate_error::SimulateError;
 use crate::simulator::Simulator;
 use metrics::FrameMetrics;
 pub use performer::Performer;
-use pins::{Pins, read_pins};
+pub use pins::Pins;
+use pins::read_pins;
 use placement::check_placement;
 use progress::{ClothRun, Progress, read_checkpoint, write_checkpoint};
 pub use settings::SimulateSettings;
 pub use stepping::{SETTLE_SECONDS, Stepping};
 
-/// What a run simulates: the garment (`.obj`, metres, modelled around the body at rest) and its
-/// pins file, on the body performing the motion.
+/// What a run simulates: the garment (its file, `.obj` or `.garment`, named in messages and
+/// hashed into the run, with its pins file) ready to simulate, on the body performing the motion.
 pub struct SimulateJob<'a> {
-    pub garment: &'a Path,
-    pub pins: Option<&'a Path>,
+    pub garment_path: &'a Path,
+    pub pins_path: Option<&'a Path>,
+    pub garment: GarmentInput,
     pub performer: Performer<'a>,
+}
+
+/// A garment ready to simulate: its mesh around the body at rest (metres), the vertices held,
+/// and its fabric when its file names one.
+pub struct GarmentInput {
+    pub mesh: TriMesh,
+    pub pins: Pins,
+    pub material: Option<Material>,
+}
+
+impl GarmentInput {
+    /// A bare mesh (`.obj`) and its pins file. A mesh with nothing attached hangs on the body
+    /// by friction alone, so that is said.
+    pub fn read_obj(path: &Path, pins: Option<&Path>) -> Result<Self, SimulateError> {
+        let mesh = read_obj(path)?;
+        let pins = match pins {
+            Some(p) => read_pins(p, mesh.vertex_count())?,
+            None => Pins::default(),
+        };
+        if pins.attached.is_empty() && pins.fixed.is_empty() {
+            tracing::warn!(
+                "{}: a bare mesh with no --pin: nothing holds it on the body (a skirt or trousers \
+                 slides down); a library garment's .garment file carries its waistband",
+                path.display()
+            );
+        }
+        Ok(Self { mesh, pins, material: None })
+    }
 }
 
 /// A run simulated as far as it went: the motion frames recorded and their metrics, and the
@@ -61,13 +92,10 @@ pub fn simulate(
     settings: &SimulateSettings,
     out: &Path,
 ) -> Result<Simulation, SimulateError> {
-    let garment_path = job.garment;
-    let garment = read_obj(garment_path)?;
-    let pins = match job.pins {
-        Some(p) => read_pins(p, garment.vertex_count())?,
-        None => Pins::default(),
-    };
-    let cloth = Cloth::new(&garment, &settings.material, &pins.fixed)
+    let garment_path = job.garment_path;
+    let (garment, pins) = (&job.garment.mesh, &job.garment.pins);
+    let material = settings.material.or(job.garment.material).unwrap_or_default();
+    let cloth = Cloth::new(garment, &material, &pins.fixed)
         .map_err(|e| SimulateError::from(e).of(garment_path.display().to_string()))?;
     let (model, motion) = (job.performer.model, job.performer.motion);
     check_kept_positions(job.performer.motion_path, motion.num_frames(), garment.vertex_count())?;
@@ -79,7 +107,7 @@ pub fn simulate(
         Ok(points(pose_frames(model, &shaped, pose, trans)?.frame_vertices(0)))
     };
     let rest = body_at(0)?;
-    check_placement(garment_path, &garment, &rest)?;
+    check_placement(garment_path, garment, &rest)?;
     let attachments: Vec<Attachment> = pins
         .attached
         .iter()
@@ -88,7 +116,7 @@ pub fn simulate(
 
     let run = ClothRun {
         garment: file_hash(garment_path)?,
-        pins: match job.pins {
+        pins: match job.pins_path {
             Some(p) => file_hash(p)?,
             None => "none".into(),
         },
@@ -97,7 +125,7 @@ pub fn simulate(
         betas: job.performer.betas.to_vec(),
         fps: motion.fps,
         frames: motion.num_frames(),
-        material: settings.material,
+        material,
         substeps: settings.stepping.substeps,
         settle: settings.stepping.settle,
         self_collision: settings.self_collision,
@@ -160,7 +188,7 @@ pub fn simulate(
         Err(e) if progress.frames.is_empty() => return Err(e),
         outcome => outcome.err(),
     };
-    Ok(Simulation { garment, progress, phases: sim.phase_times(), stopped, checkpoint })
+    Ok(Simulation { garment: garment.clone(), progress, phases: sim.phase_times(), stopped, checkpoint })
 }
 
 impl Simulation {

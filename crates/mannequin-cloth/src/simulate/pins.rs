@@ -5,8 +5,9 @@ use std::path::Path;
 
 use crate::simulate_error::SimulateError;
 
-/// The vertices a pins file names.
-#[derive(Debug, Default, serde::Deserialize)]
+/// The vertices a pins file names: fixed in place, or attached to the body surface nearest them
+/// at rest.
+#[derive(Debug, Clone, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Pins {
     #[serde(default)]

@@ -9,8 +9,9 @@ use crate::material::Material;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, clap::Args)]
 pub struct SimulateSettings {
-    #[arg(long = "material", value_enum, default_value_t = SimulateSettings::default().material)]
-    pub material: Material,
+    /// The fabric [default: the .garment's own, or cotton for an .obj].
+    #[arg(long = "material", value_enum)]
+    pub material: Option<Material>,
     #[command(flatten)]
     #[serde(flatten)]
     pub stepping: Stepping,
@@ -30,7 +31,7 @@ pub struct SimulateSettings {
 impl Default for SimulateSettings {
     fn default() -> Self {
         Self {
-            material: Material::default(),
+            material: None,
             stepping: Stepping::default(),
             self_collision: false,
             checkpoint_every: 30,
