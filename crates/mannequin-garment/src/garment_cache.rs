@@ -37,8 +37,7 @@ pub fn load_or_make(
             )
             .into());
         }
-        let garment = read_garment(path)?;
-        garment.check_body(model).map_err(|e| DressError::from(e).of(path.display().to_string()))?;
+        let garment = read_for_body(path, model)?;
         let name = path.file_stem().map_or_else(|| "garment".into(), |s| s.to_string_lossy().into_owned());
         return Ok((name, garment));
     };
@@ -71,6 +70,13 @@ pub fn load_or_make(
         }
     }
     Ok((category.name().to_string(), garment))
+}
+
+/// The `.garment` file at `path`, checked against the body `model` it is to be worn on.
+pub fn read_for_body(path: &Path, model: &BodyModel) -> Result<Garment, DressError> {
+    let garment = read_garment(path)?;
+    garment.check_body(model).map_err(|e| DressError::from(e).of(path.display().to_string()))?;
+    Ok(garment)
 }
 
 /// `$XDG_CACHE_HOME/mannequin`, or `~/.cache/mannequin`.

@@ -29,7 +29,7 @@ pub use dressing::{DressJob, DressSettings, Dressing, Wardrobe, dress};
 pub use ease::{Ease, SIZE_NAMES};
 pub use error::GarmentError;
 pub use garment::{Garment, Recipe};
-pub use garment_cache::load_or_make;
+pub use garment_cache::{load_or_make, read_for_body};
 pub use layered_scene::write_layered_scene;
 pub use make::{TEMPLATE_REVISION, make_garment};
 pub use transfer::Dressed;

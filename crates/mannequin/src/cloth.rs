@@ -8,8 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use mannequin_body::{BodyModel, load_body};
 use mannequin_cloth::{GarmentInput, Pins, SimulateJob, SimulateSettings, simulate};
-use mannequin_garment::Dressed;
-use mannequin_garment::file::read_garment;
+use mannequin_garment::{Dressed, read_for_body};
 use mannequin_io::progress::JobTimer;
 use mannequin_io::staging::Staging;
 use mannequin_mesh::TriMesh;
@@ -80,10 +79,8 @@ fn simulate_garment(args: SimulateArgs) -> Result<()> {
 /// The library garment at `path` put on the body of shape `betas` at rest (Eq. 3.2), its
 /// waistband attached as `dress` attaches it, in its own fabric.
 fn worn(path: &Path, model: &BodyModel, betas: &[f32]) -> Result<GarmentInput> {
-    let garment = read_garment(path)?;
-    let context = || path.display().to_string();
-    garment.check_body(model).with_context(context)?;
-    let dressed = Dressed::new(&garment, model, betas).with_context(context)?;
+    let garment = read_for_body(path, model)?;
+    let dressed = Dressed::new(&garment, model, betas).with_context(|| path.display().to_string())?;
     let pins = Pins { fixed: Vec::new(), attached: dressed.held() };
     let mesh = TriMesh::new(dressed.rest(), garment.mesh.faces.clone());
     Ok(GarmentInput { mesh, pins, material: Some(garment.recipe.material) })
