@@ -53,19 +53,23 @@ impl PersonModels {
     }
 
     /// Everyone found in the picture, largest box first: those the detector finds in the whole
-    /// picture; where it finds nobody, those it finds in overlapping square parts of it
-    /// ([`PersonModels::in_windows`]); where that finds nobody either, the bodies below the faces
-    /// BlazeFace finds ([`PersonModels::below_faces`]). The landmarker confirms each.
-    pub fn people(&self, image: &Image) -> Result<Vec<Person>, FitError> {
-        let found = self.in_whole_picture(image)?;
-        if !found.is_empty() {
+    /// picture; where that is fewer than `wanted`, also those it finds in overlapping square
+    /// parts of it ([`PersonModels::in_windows`]); where that is still fewer, also the bodies
+    /// below the faces BlazeFace finds ([`PersonModels::below_faces`]). The landmarker confirms
+    /// each. `wanted` is how many people the caller needs (`--person n` needs n + 1): the
+    /// detector can miss one small person of two side by side that a window finds.
+    pub fn people(&self, image: &Image, wanted: usize) -> Result<Vec<Person>, FitError> {
+        let mut found = self.in_whole_picture(image)?;
+        if found.len() >= wanted {
             return Ok(found);
         }
-        let found = self.in_windows(image)?;
-        if !found.is_empty() {
+        found.extend(self.in_windows(image)?);
+        found = distinct(found);
+        if found.len() >= wanted {
             return Ok(found);
         }
-        self.below_faces(image)
+        found.extend(self.below_faces(image)?);
+        Ok(distinct(found))
     }
 
     /// Everyone the detector finds in the whole picture (letterboxed) whose landmark crop the
@@ -187,6 +191,11 @@ pub fn body_box(l: &PoseLandmarks) -> [f32; 4] {
         .fold([f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY], |[x0, y0, x1, y1], p| {
             [x0.min(p[0]), y0.min(p[1]), x1.max(p[0]), y1.max(p[1])]
         })
+}
+
+/// How many people `--person` needs found: n + 1 for `--person n`, else one.
+pub fn wanted_count(wanted: Option<usize>) -> usize {
+    wanted.map_or(1, |n| n + 1)
 }
 
 /// The person `wanted` names (counting from 0, largest first), else the only or clearly largest
