@@ -63,13 +63,14 @@ impl PersonModels {
         if found.len() >= wanted {
             return Ok(found);
         }
-        found.extend(self.in_windows(image)?);
-        found = distinct(found);
+        let more = self.in_windows(image)?;
+        found.extend(elsewhere(&found, more));
         if found.len() >= wanted {
-            return Ok(found);
+            return Ok(by_size(found));
         }
-        found.extend(self.below_faces(image)?);
-        Ok(distinct(found))
+        let more = self.below_faces(image)?;
+        found.extend(elsewhere(&found, more));
+        Ok(by_size(found))
     }
 
     /// Everyone the detector finds in the whole picture (letterboxed) whose landmark crop the
@@ -132,8 +133,7 @@ impl PersonModels {
                 out.push(Person { detection, landmarks });
             }
         }
-        out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
-        Ok(out)
+        Ok(by_size(out))
     }
 
     /// The landmarks read again in the crop they themselves point to: the detector's crop is
@@ -173,8 +173,34 @@ fn distinct(mut people: Vec<Person>) -> Vec<Person> {
             out.push(person);
         }
     }
-    out.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
-    out
+    by_size(out)
+}
+
+/// Those of `more` whose bodies lie mostly outside every body in `found`: a window or a face
+/// that sees part of someone already found (their head, their chest) reads a smaller body
+/// within theirs, too unlike their own reading for [`distinct`] to merge.
+fn elsewhere(found: &[Person], more: Vec<Person>) -> Vec<Person> {
+    more.into_iter()
+        .filter(|p| {
+            let body = body_box(&p.landmarks);
+            !found.iter().any(|f| share_of_smaller(&body_box(&f.landmarks), &body) > SAME_BODY)
+        })
+        .collect()
+}
+
+/// The share of the smaller of two boxes that lies within the other.
+fn share_of_smaller(a: &[f32; 4], b: &[f32; 4]) -> f32 {
+    let area = |r: &[f32; 4]| (r[2] - r[0]).max(0.0) * (r[3] - r[1]).max(0.0);
+    let w = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
+    let h = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
+    let smaller = area(a).min(area(b));
+    if smaller > 0.0 { w * h / smaller } else { 0.0 }
+}
+
+/// `people` largest box first.
+fn by_size(mut people: Vec<Person>) -> Vec<Person> {
+    people.sort_by(|a, b| b.detection.area().total_cmp(&a.detection.area()));
+    people
 }
 
 /// Whether the body read below a face is that face's: its nose (landmark 0) on the face's box.
