@@ -141,6 +141,9 @@ impl Simulator {
             let t = Instant::now();
             self.cloth.stretch.project(&mut self.positions, w, &mut self.stretch_lambda, dt);
             self.tethers.project(&mut self.positions, w);
+            // Before the body and the contacts, which have the last word on where cloth may be.
+            let limit = self.cloth.material.strain_limit;
+            self.cloth.stretch.limit_strain(&mut self.positions, w, limit, &mut self.stretch_lambda);
             self.times.stretch += t.elapsed();
             let t = Instant::now();
             self.cloth.bending.project(&mut self.positions, w, &mut self.bending_lambda, dt);
