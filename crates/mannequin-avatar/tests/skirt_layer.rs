@@ -50,9 +50,10 @@ fn a_dress_gets_a_layer_on_the_ground_truth_skirt() {
     let hem = boundary_loops(&dress.faces).iter().map(height).fold(f32::INFINITY, f32::min);
     let soles = body.vertices.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min);
     let layer_hem = layer.hem - soles;
-    // On the garment library's draped dress the layer's hem sits 5.1 cm above the dress's
-    // (seed 1): the masks' gap between the legs fills only where the flared dress spans it.
-    assert!((layer_hem - hem).abs() < 0.06, "hem {layer_hem} m above the soles, the generator's {hem} m");
+    // On the garment library's draped, strain-limited dress the layer's hem sits 6.2 cm above
+    // the dress's (seed 1): the masks' gap between the legs fills only where the flared dress
+    // spans it.
+    assert!((layer_hem - hem).abs() < 0.07, "hem {layer_hem} m above the soles, the generator's {hem} m");
 
     // Posed by the avatar (zero offsets at initialisation) into a training frame, the layer's
     // vertices lie on the ground-truth clothed mesh.
