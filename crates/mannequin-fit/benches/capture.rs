@@ -69,7 +69,7 @@ fn main() {
 
         let start = Instant::now();
         let models = PersonModels::load().expect("models");
-        let one = models.people(&frames[0].image, 1).expect("people");
+        let one = models.people(&frames[0].image, None).expect("people");
         fit_body(&model, &one[0].landmarks, width, height, assumed_focal(width, height)).expect("fit");
         let one_image = start.elapsed().as_secs_f64();
 

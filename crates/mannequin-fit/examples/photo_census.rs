@@ -72,7 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         };
         let start = Instant::now();
-        let people = models.people(&image, 1)?;
+        let people = models.people(&image, None)?;
         let seconds = start.elapsed().as_secs_f64();
         let on = |p: &Person, h: &Head| p.landmarks.points.first().is_some_and(|n| h.holds([n[0], n[1]]));
         let is_real = |p: &Person| heads.iter().any(|h| on(p, h));

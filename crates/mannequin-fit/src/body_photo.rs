@@ -17,7 +17,7 @@ use crate::face_models::{FaceModels, MIN_FACE_PX};
 use crate::fit_check::{check_picture, posed_mesh};
 use crate::fit_settings::FitSettings;
 use crate::output::{create_dir, write_report};
-use crate::person_models::{Person, PersonModels, pick_person, wanted_count};
+use crate::person_models::{Person, PersonModels, pick_person};
 use crate::pose_landmarker::PoseLandmarks;
 
 /// The detector reads a 224² letterbox: smaller pictures hold too little to find a body in.
@@ -58,7 +58,7 @@ pub fn fit_photo(job: &BodyPhoto) -> Result<BodyPhotoSummary, FitError> {
     job.fitting.check()?;
     let model = job.fitting.body_model()?;
     let models = PersonModels::load()?;
-    let people = models.people(&image, wanted_count(job.person))?;
+    let people = models.people(&image, job.person)?;
     let person =
         pick_person(&people, job.person).map_err(|e| FitError::within(job.image.display().to_string(), e))?;
     let landmarks = models.refine(&image, person.landmarks.clone())?;

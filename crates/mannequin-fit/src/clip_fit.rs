@@ -18,7 +18,7 @@ use mannequin_data::Image;
 use crate::body_fit::{Anchor, BodyFit, Fitter, FramePose, rotation_gap};
 use crate::crop::RotatedRect;
 use crate::error::FitError;
-use crate::person_models::{Person, PersonModels, body_box, pick_person, wanted_count};
+use crate::person_models::{Person, PersonModels, body_box, pick_person};
 use crate::pose_landmarker::PoseLandmarks;
 use crate::ssd_detector::box_iou;
 
@@ -144,7 +144,7 @@ impl<'a> Tracker<'a> {
         };
         let found = match followed {
             Some(l) => Some(l),
-            None => match self.find_again(&self.models.people(image, wanted_count(self.wanted))?)? {
+            None => match self.find_again(&self.models.people(image, self.wanted)?)? {
                 Some(person) => Some(self.models.refine(image, person.landmarks.clone())?),
                 None => None,
             },

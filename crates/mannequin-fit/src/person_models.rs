@@ -11,7 +11,7 @@ use crate::face_models::FACE_DETECTION;
 use crate::network::Network;
 use crate::person_search::{body_seeds, windows};
 use crate::pose_landmarker::{MIN_POSE_FLAG, PoseLandmarks, aligned_roi, detection_roi, estimate};
-use crate::ssd_detector::{Detection, FACE, POSE, box_iou, letterbox, suppress};
+use crate::ssd_detector::{Detection, FACE, POSE, box_area, box_intersection, box_iou, letterbox, suppress};
 
 const POSE_DETECTION: &[u8] = include_bytes!("../models/pose_detection.onnx");
 const POSE_LANDMARK: &[u8] = include_bytes!("../models/pose_landmark_full.onnx");
@@ -53,12 +53,12 @@ impl PersonModels {
     }
 
     /// Everyone found in the picture, largest box first: those the detector finds in the whole
-    /// picture; where that is fewer than `wanted`, also those it finds in overlapping square
-    /// parts of it ([`PersonModels::in_windows`]); where that is still fewer, also the bodies
-    /// below the faces BlazeFace finds ([`PersonModels::below_faces`]). The landmarker confirms
-    /// each. `wanted` is how many people the caller needs (`--person n` needs n + 1): the
-    /// detector can miss one small person of two side by side that a window finds.
-    pub fn people(&self, image: &Image, wanted: usize) -> Result<Vec<Person>, FitError> {
+    /// picture; where that is fewer than `person` needs (`--person n` needs n + 1, none needs
+    /// one), also those it finds in overlapping square parts of it
+    /// ([`PersonModels::in_windows`]); where that is still fewer, also the bodies below the
+    /// faces BlazeFace finds ([`PersonModels::below_faces`]). The landmarker confirms each. The detector can miss one small person of two side by side that a window finds.
+    pub fn people(&self, image: &Image, person: Option<usize>) -> Result<Vec<Person>, FitError> {
+        let wanted = person.map_or(1, |n| n + 1);
         let mut found = self.in_whole_picture(image)?;
         if found.len() >= wanted {
             return Ok(found);
@@ -190,11 +190,8 @@ fn elsewhere(found: &[Person], more: Vec<Person>) -> Vec<Person> {
 
 /// The share of the smaller of two boxes that lies within the other.
 fn share_of_smaller(a: &[f32; 4], b: &[f32; 4]) -> f32 {
-    let area = |r: &[f32; 4]| (r[2] - r[0]).max(0.0) * (r[3] - r[1]).max(0.0);
-    let w = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
-    let h = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
-    let smaller = area(a).min(area(b));
-    if smaller > 0.0 { w * h / smaller } else { 0.0 }
+    let smaller = box_area(a).min(box_area(b));
+    if smaller > 0.0 { box_intersection(a, b) / smaller } else { 0.0 }
 }
 
 /// `people` largest box first.
@@ -217,11 +214,6 @@ pub fn body_box(l: &PoseLandmarks) -> [f32; 4] {
         .fold([f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY], |[x0, y0, x1, y1], p| {
             [x0.min(p[0]), y0.min(p[1]), x1.max(p[0]), y1.max(p[1])]
         })
-}
-
-/// How many people `--person` needs found: n + 1 for `--person n`, else one.
-pub fn wanted_count(wanted: Option<usize>) -> usize {
-    wanted.map_or(1, |n| n + 1)
 }
 
 /// The person `wanted` names (counting from 0, largest first), else the only or clearly largest

@@ -59,14 +59,19 @@ impl Detection {
 
 /// Intersection over union of two boxes (xmin, ymin, xmax, ymax).
 pub fn box_iou(a: &[f32; 4], b: &[f32; 4]) -> f32 {
-    let w = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
-    let h = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
-    let inter = w * h;
+    let inter = box_intersection(a, b);
     let union = box_area(a) + box_area(b) - inter;
     if union > 0.0 { inter / union } else { 0.0 }
 }
 
-fn box_area(r: &[f32; 4]) -> f32 {
+/// The area two boxes share.
+pub(crate) fn box_intersection(a: &[f32; 4], b: &[f32; 4]) -> f32 {
+    let w = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
+    let h = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
+    w * h
+}
+
+pub(crate) fn box_area(r: &[f32; 4]) -> f32 {
     (r[2] - r[0]).max(0.0) * (r[3] - r[1]).max(0.0)
 }
 

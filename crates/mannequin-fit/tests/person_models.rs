@@ -94,7 +94,7 @@ fn the_whole_pipeline_finds_mediapipes_landmarks() {
         let npz = Npz::read(data(&format!("pipeline_{picture}.npz"))).unwrap();
         assert_eq!(array(&npz, "found"), [1.0], "the fixture found a person in {picture}");
         let image = Image::read(&data(&format!("{picture}.png"))).unwrap();
-        let people = models().people(&image, 1).unwrap();
+        let people = models().people(&image, None).unwrap();
         assert!(!people.is_empty(), "{picture}: nobody found");
         let p = &people[0].landmarks;
         let want = array(&npz, "landmarks_px");

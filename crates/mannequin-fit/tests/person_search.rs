@@ -33,7 +33,7 @@ fn landscape(person: &Image, factor: usize, width: usize, height: usize, at: [us
 #[test]
 fn a_small_person_in_a_wide_picture_is_found_in_the_windows_where_they_are() {
     let astronaut = picture("astronaut.png");
-    let whole = models().people(&astronaut, 1).unwrap();
+    let whole = models().people(&astronaut, None).unwrap();
     let nose = whole[0].landmarks.points[0];
     let (factor, at) = (4, [1750, 200]);
     let canvas = landscape(&astronaut, factor, 2000, 400, at);
@@ -41,7 +41,7 @@ fn a_small_person_in_a_wide_picture_is_found_in_the_windows_where_they_are() {
         models().in_whole_picture(&canvas).unwrap().is_empty(),
         "the whole-picture detector should miss the person, or the test tests nothing"
     );
-    let people = models().people(&canvas, 1).unwrap();
+    let people = models().people(&canvas, None).unwrap();
     assert_eq!(
         people.len(),
         1,
