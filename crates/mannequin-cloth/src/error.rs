@@ -17,6 +17,13 @@ pub enum ClothError {
     NonManifoldEdge { a: u32, b: u32, count: usize },
     #[error("pins[{index}] = {vertex} is out of range: the garment has {count} vertices")]
     PinIndex { index: usize, vertex: u32, count: usize },
+    /// Self-collision keeps apart what starts apart; a mesh that starts crossed stays crossed.
+    #[error(
+        "the garment starts crossing itself: {pairs} pairs of triangles intersect, the first faces {first} \
+         and {second} near ({x:.3}, {y:.3}, {z:.3}) m; self-collision keeps apart only what starts apart \
+         (untangle the mesh, or turn self-collision off)"
+    )]
+    StartsCrossed { pairs: usize, first: usize, second: usize, x: f32, y: f32, z: f32 },
     #[error("the simulation blew up: particle {particle} is no longer finite")]
     NonFinite { particle: usize },
 }

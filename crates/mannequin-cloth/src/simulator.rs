@@ -53,6 +53,9 @@ impl Simulator {
         for a in &attachments {
             inverse_mass[a.particle as usize] = 0.0;
         }
+        if settings.self_collision {
+            check_uncrossed(&cloth.start, &cloth.faces)?;
+        }
         let anchors: Vec<u32> = attachments.iter().map(|a| a.particle).collect();
         let tethers = if anchors.is_empty() {
             Tethers::default()
@@ -66,7 +69,7 @@ impl Simulator {
             attachments,
             contacts: settings
                 .self_collision
-                .then(|| SelfContacts::new(settings.thickness, cloth.edges(), n)),
+                .then(|| SelfContacts::new(settings.thickness, cloth.edges(), cloth.start.clone())),
             positions: cloth.start.clone(),
             velocities: vec![[0.0; 3]; n],
             previous: cloth.start.clone(),
@@ -101,7 +104,7 @@ impl Simulator {
             }
         }
         if let Some(contacts) = &mut self.contacts {
-            contacts.begin_frame(self.body.as_ref().map_or(0.0, |b| b.step));
+            contacts.begin_frame();
         }
         let dt = frame_dt / substeps as f32;
         for k in 0..substeps {
@@ -125,13 +128,10 @@ impl Simulator {
         }
         let t = Instant::now();
         self.predict(dt);
-        if let Some(contacts) = &self.contacts {
-            contacts.bound_displacements(&mut self.positions, &self.previous, &self.inverse_mass);
-        }
         self.times.prediction += t.elapsed();
         if let Some(contacts) = &mut self.contacts {
             let t = Instant::now();
-            contacts.refresh(&self.positions, &self.previous, &self.cloth.faces);
+            contacts.begin_substep(&self.previous, &self.cloth.faces);
             self.times.hashing += t.elapsed();
         }
         self.stretch_lambda.fill(0.0);
@@ -148,19 +148,23 @@ impl Simulator {
             let t = Instant::now();
             self.cloth.bending.project(&mut self.positions, w, &mut self.bending_lambda, dt);
             self.times.bending += t.elapsed();
-            if let Some(contacts) = &mut self.contacts {
-                let t = Instant::now();
-                contacts.project(&mut self.positions, &self.previous, w, &self.cloth.faces);
-                self.times.self_contacts += t.elapsed();
-            }
             if let Some(body) = &self.body {
                 let t = Instant::now();
                 let (margin, friction) = (self.settings.body_margin, self.cloth.material.friction);
                 body.project(&mut self.positions, &self.previous, w, margin, friction);
                 self.times.body_contacts += t.elapsed();
             }
+            // Last, so the body's push does not undo them: what they leave undone the safe step holds.
+            if let Some(contacts) = &self.contacts {
+                let t = Instant::now();
+                contacts.project(&mut self.positions, &self.previous, w, &self.cloth.faces);
+                self.times.self_contacts += t.elapsed();
+            }
         }
         let t = Instant::now();
+        if let Some(contacts) = &mut self.contacts {
+            contacts.end_substep(&mut self.positions, &self.previous, &self.inverse_mass, &self.cloth.faces);
+        }
         self.update_velocities(dt);
         self.times.prediction += t.elapsed();
     }
@@ -227,4 +231,16 @@ impl Simulator {
         self.velocities = state.velocities;
         Ok(())
     }
+}
+
+/// Refuses a start where the cloth crosses itself, with the count and the place of the first
+/// crossing: the safe step would hold such a pair crossed for ever.
+fn check_uncrossed(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Result<(), ClothError> {
+    let crossed = crate::quality::self_intersections(positions, faces);
+    let Some(&[first, second]) = crossed.first() else {
+        return Ok(());
+    };
+    let corners = faces[first].iter().chain(&faces[second]).map(|&v| Vec3::from(positions[v as usize]));
+    let [x, y, z] = (corners.sum::<Vec3>() / 6.0).to_array();
+    Err(ClothError::StartsCrossed { pairs: crossed.len(), first, second, x, y, z })
 }

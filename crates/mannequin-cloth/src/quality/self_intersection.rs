@@ -16,6 +16,12 @@ const MAX_SPAN_CELLS: i64 = 16;
 /// The number of intersecting pairs of triangles with no vertex in common. Faces with an index out
 /// of range are ignored.
 pub fn self_intersecting_pairs(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> usize {
+    self_intersections(positions, faces).len()
+}
+
+/// The intersecting pairs of triangles with no vertex in common, as face indices (i < j), in
+/// ascending order: where a mesh crosses itself.
+pub fn self_intersections(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Vec<[usize; 2]> {
     intersecting_pairs(positions, faces, |_, _| true)
 }
 
@@ -30,15 +36,16 @@ pub fn crossing_pairs(a: &[[f32; 3]], a_faces: &[[u32; 3]], b: &[[f32; 3]], b_fa
     let mut faces: Vec<[u32; 3]> = a_faces.iter().copied().filter(|f| f.iter().all(|&i| i < n)).collect();
     let first_of_b = faces.len();
     faces.extend(b_faces.iter().map(|t| t.map(|i| i.saturating_add(n))));
-    intersecting_pairs(&positions, &faces, |i, j| (i < first_of_b) != (j < first_of_b))
+    intersecting_pairs(&positions, &faces, |i, j| (i < first_of_b) != (j < first_of_b)).len()
 }
 
-/// Intersecting pairs of faces `i`, `j` for which `counts(i, j)` holds.
+/// Intersecting pairs of faces `i` < `j` (indices into `faces`) for which `counts(i, j)` holds,
+/// in ascending order.
 fn intersecting_pairs(
     positions: &[[f32; 3]],
     faces: &[[u32; 3]],
     counts: impl Fn(usize, usize) -> bool,
-) -> usize {
+) -> Vec<[usize; 2]> {
     let faces: Vec<(usize, [u32; 3])> = faces
         .iter()
         .copied()
@@ -46,7 +53,7 @@ fn intersecting_pairs(
         .filter(|(_, f)| f.iter().all(|&i| (i as usize) < positions.len()))
         .collect();
     if faces.is_empty() {
-        return 0;
+        return Vec::new();
     }
     let corners = |f: [u32; 3]| -> [Point; 3] { f.map(|i| positions[i as usize].map(f64::from)) };
     let boxes: Vec<(Point, Point)> = faces
@@ -88,7 +95,8 @@ fn intersecting_pairs(
         let ((i, fi), (j, fj)) = (faces[i], faces[j]);
         counts(i, j) && !fi.iter().any(|v| fj.contains(v)) && triangles_intersect(corners(fi), corners(fj))
     };
-    let mut count = 0;
+    let mut found = Vec::new();
+    let mut note = |i: usize, j: usize| found.push([faces[i.min(j)].0, faces[i.max(j)].0]);
     for (cell_key, members) in &grid {
         for (n, &i) in members.iter().enumerate() {
             for &j in &members[n + 1..] {
@@ -96,17 +104,22 @@ fn intersecting_pairs(
                 if !overlap(i, j) || key([0, 1, 2].map(|k| boxes[i].0[k].max(boxes[j].0[k]))) != *cell_key {
                     continue;
                 }
-                count += usize::from(intersect(i, j));
+                if intersect(i, j) {
+                    note(i, j);
+                }
             }
         }
     }
     // Each large box against every other (a pair of large ones once).
     for i in (0..boxes.len()).filter(|&i| large[i]) {
         for j in (0..boxes.len()).filter(|&j| j != i && !(large[j] && j < i)) {
-            count += usize::from(overlap(i, j) && intersect(i, j));
+            if overlap(i, j) && intersect(i, j) {
+                note(i, j);
+            }
         }
     }
-    count
+    found.sort_unstable();
+    found
 }
 
 #[cfg(test)]

@@ -3,17 +3,17 @@
 //! through each other while every vertex stays beside the other triangles, which is how cloth
 //! crumpled at the scale of its triangles tangles.
 //!
-//! As for vertex–triangle contacts, the side is the current one unless the edges passed through
-//! each other in this substep: the four particles became coplanar at a moment when the edges
-//! met. (They also become coplanar, far apart, whenever the edges turn through parallel, which
-//! in a flat sheet happens all the time: that flips the common normal but crosses nothing.)
+//! As for vertex–triangle contacts, the side is the one at the start of the substep, which the
+//! safe step keeps.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::crossing::{between, coplanar_time, volume};
 use super::neighbours::Neighbours;
-use super::push::{Reach, push_apart};
+use super::orientation::volume;
+use super::Ends;
+use super::push::{Reach, moved, push_apart};
+use super::safe_step::Closing;
 use crate::box_hash::{Aabb, BoxHash};
 
 /// Closest points this close to an edge's end (as a fraction of it) count as at the end.
@@ -34,7 +34,10 @@ struct Pair {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct EdgeEdge {
     pairs: Vec<Pair>,
-    boxes: Vec<Aabb>,
+    /// Each pair's distance at the start of the substep.
+    start: Vec<f32>,
+    /// Each edge's box around its move, inflated by half the reach.
+    swept: Vec<Aabb>,
     hash: BoxHash,
 }
 
@@ -80,52 +83,74 @@ fn inside(x: f32) -> bool {
     x > END_TOLERANCE && x < 1.0 - END_TOLERANCE
 }
 
-/// The distance between the closest points of segments p₁p₂ and q₁q₂.
-fn segment_distance(p1: Vec3, p2: Vec3, q1: Vec3, q2: Vec3) -> f32 {
+/// The distance between the closest points of edges `e1` and `e2` at `positions`.
+fn edge_distance(positions: &[[f32; 3]], e1: [u32; 2], e2: [u32; 2]) -> f32 {
+    let [p1, p2, q1, q2] = [e1[0], e1[1], e2[0], e2[1]].map(|i| Vec3::from(positions[i as usize]));
     let (s, t) = closest_fractions(p1, p2, q1, q2);
     (p1 + s * (p2 - p1)).distance(q1 + t * (q2 - q1))
 }
 
 impl EdgeEdge {
-    /// Every pair of edges without a common vertex within reach at `reference`. Each edge's box
-    /// is inflated by the reach and half the longest edge, so it holds the midpoint of every edge
-    /// within reach, which is what each edge queries with.
-    pub fn rebuild(&mut self, reference: &[[f32; 3]], edges: &[[u32; 2]], reach: Reach, near: &Neighbours) {
-        let at = |i: u32| Vec3::from(reference[i as usize]);
-        let longest = edges.iter().map(|&[a, b]| at(a).distance(at(b))).fold(0.0, f32::max);
-        self.boxes.clear();
-        self.boxes
-            .extend(edges.iter().map(|e| Aabb::around(&e.map(at)).inflated(reach.distance + 0.5 * longest)));
-        let extents: f32 = self.boxes.iter().map(|b| b.extent().max_element()).sum();
-        self.hash.build(&self.boxes, extents / self.boxes.len().max(1) as f32);
-        let (hash, boxes) = (&self.hash, &self.boxes);
-        let found: Vec<Vec<Pair>> = (0..edges.len() as u32)
+    /// Every pair of edges without a common vertex that can come within reach while moving
+    /// straight from `from` to `to` (their boxes around both, inflated by half the reach,
+    /// overlap, and its distance at `from` less what its moves can close is within reach), with
+    /// its distance at `from`; `initial` is the cloth's start shape, which caps
+    /// each pair's gap.
+    pub fn rebuild(&mut self, ends: Ends, initial: &[[f32; 3]], edges: &[[u32; 2]], reach: Reach, near: &Neighbours) {
+        self.swept.clear();
+        self.swept.extend(edges.iter().map(|e| ends.swept(e).inflated(0.5 * reach.distance)));
+        let extents: f32 = self.swept.iter().map(|b| b.extent().max_element()).sum();
+        self.hash.build(&self.swept, extents / self.swept.len().max(1) as f32);
+        let (hash, swept) = (&self.hash, &self.swept);
+        let found: Vec<Vec<(Pair, f32)>> = (0..edges.len() as u32)
             .into_par_iter()
             .map(|first| {
                 let e1 = edges[first as usize];
-                let (p1, p2) = (at(e1[0]), at(e1[1]));
-                let middle = 0.5 * (p1 + p2);
-                hash.containing(boxes, middle)
-                    .filter(|&second| {
-                        second > first && !edges[second as usize].iter().any(|v| e1.contains(v))
-                    })
-                    .filter_map(|second| {
-                        let e2 = edges[second as usize];
-                        let (q1, q2) = (at(e2[0]), at(e2[1]));
-                        if segment_distance(p1, p2, q1, q2) > reach.distance {
-                            return None;
-                        }
-                        Some(Pair { first, second, gap: reach.gap(near.touch(&e1, &e2)) })
-                    })
-                    .collect()
+                let mut pairs = Vec::new();
+                hash.for_each_overlapping(swept, &swept[first as usize], |second| {
+                    let e2 = edges[second as usize];
+                    if second <= first || e2.iter().any(|v| e1.contains(v)) {
+                        return;
+                    }
+                    let start = edge_distance(ends.from, e1, e2);
+                    if start - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < reach.distance {
+                        let gap = reach.gap(near.touch(&e1, &e2), edge_distance(initial, e1, e2));
+                        pairs.push((Pair { first, second, gap }, start));
+                    }
+                });
+                pairs
             })
             .collect();
-        self.pairs.clear();
-        self.pairs.extend(found.into_iter().flatten());
+        (self.pairs, self.start) = found.into_iter().flatten().unzip();
+    }
+
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Notes each pair's distance at `positions`, the start of the substep.
+    pub fn measure(&mut self, positions: &[[f32; 3]], edges: &[[u32; 2]]) {
+        self.start.clear();
+        self.start.par_extend(
+            self.pairs
+                .par_iter()
+                .map(|pair| edge_distance(positions, edges[pair.first as usize], edges[pair.second as usize])),
+        );
+    }
+
+    /// Each pair's particles, the first edge's ends then the second's, with its distance at the
+    /// start of the substep.
+    pub fn closing(&self, edges: &[[u32; 2]], out: &mut Vec<Closing>) {
+        out.extend(self.pairs.iter().zip(&self.start).map(|(pair, &distance)| {
+            let ([a, b], [c, d]) = (edges[pair.first as usize], edges[pair.second as usize]);
+            ([a, b, c, d], distance)
+        }));
     }
 
     /// One Gauss–Seidel pass over the pairs, in their (first, second) order; `previous` holds the
-    /// positions at the start of the substep.
+    /// positions at the start of the substep, which say each pair's side. Edges passing each
+    /// other inside both are kept their gap apart along the common normal on their side; others
+    /// (near an end, or near parallel) along the line between their closest points.
     pub fn project(
         &self,
         positions: &mut [[f32; 3]],
@@ -134,35 +159,38 @@ impl EdgeEdge {
         edges: &[[u32; 2]],
         most: f32,
     ) {
-        for pair in &self.pairs {
-            let ([a, b], [c, d]) = (edges[pair.first as usize], edges[pair.second as usize]);
-            let particles = [a, b, c, d];
-            let now = particles.map(|i| Vec3::from(positions[i as usize]));
-            let [p1, p2, q1, q2] = now;
-            let Some((separation, normal, s, t)) = lines_passing(p1, p2, q1, q2) else {
-                continue;
-            };
-            // The volume of (q₁, p₁, p₂, q₂) is m·(p₁ − q₁): the separation times |m|.
-            let order = |x: [Vec3; 4]| [x[2], x[0], x[1], x[3]];
-            let start = particles.map(|i| Vec3::from(previous[i as usize]));
-            let (before, after) = (volume(order(start)), volume(order(now)));
-            let crossed = before * after < 0.0 && {
-                let [p1, p2, q1, q2] = between(start, now, coplanar_time(order(start), order(now)));
-                lines_passing(p1, p2, q1, q2).is_some_and(|(_, _, s, t)| {
-                    [s, t].iter().all(|x| (-END_TOLERANCE..=1.0 + END_TOLERANCE).contains(x))
-                })
-            };
-            let side = if crossed { -separation.signum() } else { separation.signum() };
-            if !(crossed || inside(s) && inside(t)) {
+        for (pair, &start) in self.pairs.iter().zip(&self.start) {
+            let (first, second) = (edges[pair.first as usize], edges[pair.second as usize]);
+            // A pair that cannot be within its gap is skipped before the cost of its closest points.
+            if start - moved(positions, previous, &first) - moved(positions, previous, &second) >= pair.gap {
                 continue;
             }
-            let violation = (side * separation - pair.gap).max(-most);
+            let ([a, b], [c, d]) = (first, second);
+            let particles = [a, b, c, d];
+            let [p1, p2, q1, q2] = particles.map(|i| Vec3::from(positions[i as usize]));
+            let ((s, t), direction, distance) = match lines_passing(p1, p2, q1, q2) {
+                Some((separation, normal, s, t)) if inside(s) && inside(t) => {
+                    // The volume of (q₁, p₁, p₂, q₂) is m·(p₁ − q₁): the separation times |m|.
+                    let [p1, p2, q1, q2] = particles.map(|i| Vec3::from(previous[i as usize]));
+                    let side = volume([q1, p1, p2, q2]).signum();
+                    ((s, t), side * normal, side * separation)
+                }
+                _ => {
+                    let (s, t) = closest_fractions(p1, p2, q1, q2);
+                    let away = (p1 + s * (p2 - p1)) - (q1 + t * (q2 - q1));
+                    let distance = away.length();
+                    if distance <= f32::MIN_POSITIVE {
+                        continue;
+                    }
+                    ((s, t), away / distance, distance)
+                }
+            };
+            let violation = (distance - pair.gap).max(-most);
             if violation >= 0.0 {
                 continue;
             }
-            let (s, t) = (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
             let share = [1.0 - s, s, t - 1.0, -t];
-            push_apart(positions, particles, inverse_mass, share, -violation * side * normal);
+            push_apart(positions, particles, inverse_mass, share, -violation * direction);
         }
     }
 }

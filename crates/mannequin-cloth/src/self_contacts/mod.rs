@@ -1,118 +1,115 @@
 //! Self-collision: vertex–triangle contacts (Eq. 3.22) and edge–edge contacts, each keeping the
-//! thickness h between the cloth's layers, on the side each pair was on at the start of the
-//! substep unless it got there without passing through.
+//! thickness h between the cloth's layers on the side each pair was on at the start of the
+//! substep, and a safe step that keeps any pair from passing through in between.
 //!
-//! Candidate pairs come from spatial hashes of boxes inflated by h + s, rebuilt at the start of
-//! every frame and again whenever the cloth has moved enough that a pair left out could have come
-//! within h. The slack s bounds, between rebuilds, how far any two particles may move relative to
-//! each other (relative to the common motion, so a garment carried fast by the body is not held
-//! back): each substep's displacements are clamped to stay within reach of their common centre,
-//! and the rebuild check watches the displacement since the last rebuild. Nothing is remembered
-//! from one frame to the next, so a saved state of positions and velocities resumes the same run.
+//! Candidate pairs come from spatial hashes of the boxes each element sweeps in a substep,
+//! inflated by half the reach h + s: a pair left out stays farther apart than that reach over the
+//! whole move, so only candidates need holding ([`SafeStep`]), and their distances at the end of
+//! one substep are the next substep's contacts. The hashes are built once per substep, at its end,
+//! and once at the start of every frame from where the cloth is: nothing is remembered from one
+//! frame to the next, so a saved state of positions and velocities resumes the same run.
 
-mod crossing;
 mod edge_edge;
 mod neighbours;
+mod orientation;
 mod push;
+mod safe_step;
 mod vertex_triangle;
 
 use glam::Vec3;
-use rayon::prelude::*;
 
 use crate::box_hash::Aabb;
 use edge_edge::EdgeEdge;
 use neighbours::Neighbours;
 use push::Reach;
+use safe_step::{Closing, SafeStep};
 use vertex_triangle::VertexTriangle;
 
-/// The slack s per frame is this many thicknesses, plus [`BODY_SLACK`] times the body's travel per
-/// substep (the body can push two particles apart by that much within one substep).
-const THICKNESS_SLACK: f32 = 2.0;
-const BODY_SLACK: f32 = 4.0;
-/// Of the slack, this share bounds the clamped prediction and the body's push; the rest covers
-/// the small moves of the other constraints.
-const SLACK_USE: f32 = 0.9;
-#[derive(Debug, Clone)]
+/// The slack s is this many thicknesses: the contacts of one substep are the pairs that came
+/// within h + s in the one before, so a wider reach catches faster pairs but holds more.
+const THICKNESS_SLACK: f32 = 0.5;
+/// How far past the box around its move the safe step may draw a particle, as a share of the
+/// reach: under half, so a pair left out stays apart.
+const ROOM: f32 = 0.25;
+
+/// Where a substep's moves start and end.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ends<'a> {
+    pub from: &'a [[f32; 3]],
+    pub to: &'a [[f32; 3]],
+}
+
+impl Ends<'_> {
+    /// The most the distance between two elements of `particles` can fall along their moves.
+    pub fn closing(&self, particles: [u32; 4]) -> f32 {
+        safe_step::closing(particles.map(|p| Vec3::from(self.to[p as usize]) - Vec3::from(self.from[p as usize])))
+    }
+
+    /// The box around `particles` at both ends of the move: it holds them all the way.
+    pub fn swept(&self, particles: &[u32]) -> Aabb {
+        let at = |k: usize| {
+            let p = particles[k / 2] as usize;
+            Vec3::from(if k % 2 == 0 { self.from[p] } else { self.to[p] })
+        };
+        (1..2 * particles.len()).fold(Aabb { min: at(0), max: at(0) }, |b, k| {
+            let x = at(k);
+            Aabb { min: b.min.min(x), max: b.max.max(x) }
+        })
+    }
+}
+
+#[derive(Debug)]
 pub(crate) struct SelfContacts {
     neighbours: Neighbours,
+    /// The cloth's start shape, uncrossed: what caps each pair's gap.
+    start: Vec<[f32; 3]>,
     edges: Vec<[u32; 2]>,
     vertex_triangle: VertexTriangle,
     edge_edge: EdgeEdge,
-    thickness: f32,
-    slack: f32,
-    /// The body's travel per substep in this frame.
-    body_step: f32,
-    /// Positions at the last rebuild.
-    reference: Vec<[f32; 3]>,
+    step: SafeStep,
+    closing: Vec<Closing>,
+    room: Vec<Aabb>,
+    reach: Reach,
     stale: bool,
 }
 
 impl SelfContacts {
-    pub fn new(thickness: f32, edges: Vec<[u32; 2]>, vertex_count: usize) -> Self {
+    /// Contacts of thickness h = `thickness` for a cloth of `edges` starting at `start`.
+    pub fn new(thickness: f32, edges: Vec<[u32; 2]>, start: Vec<[f32; 3]>) -> Self {
         Self {
-            neighbours: Neighbours::new(&edges, vertex_count),
+            neighbours: Neighbours::new(&edges, start.len()),
+            start,
             edges,
             vertex_triangle: VertexTriangle::default(),
             edge_edge: EdgeEdge::default(),
-            thickness,
-            slack: THICKNESS_SLACK * thickness,
-            body_step: 0.0,
-            reference: Vec::new(),
+            step: SafeStep::default(),
+            closing: Vec::new(),
+            room: Vec::new(),
+            reach: Reach { distance: (1.0 + THICKNESS_SLACK) * thickness, thickness },
             stale: true,
         }
     }
 
-    /// Starts a frame in which the body moves up to `body_step` per substep: the slack grows with
-    /// it, and the candidates are rebuilt at the first substep with fresh sides.
-    pub fn begin_frame(&mut self, body_step: f32) {
-        self.body_step = body_step;
-        self.slack = THICKNESS_SLACK * self.thickness + BODY_SLACK * body_step;
+    /// Starts a frame: the candidates are found afresh at its first substep.
+    pub fn begin_frame(&mut self) {
         self.stale = true;
     }
 
-    /// Clamps this substep's predicted displacements (free particles only) to within d of their
-    /// common centre on each axis, with d chosen so that, with the body's push, no two particles
-    /// close by more than the slack in one substep.
-    pub fn bound_displacements(
-        &self,
-        positions: &mut [[f32; 3]],
-        previous: &[[f32; 3]],
-        inverse_mass: &[f32],
-    ) {
-        let limit = self.budget() / (2.0 * 3f32.sqrt());
-        let moved = spread(positions, previous);
-        if moved.extent().max_element() <= 2.0 * limit {
-            return;
+    /// Starts a substep from `previous` (the last resolved positions): finds the pairs within
+    /// reach there if the frame just began, else notes the last substep's pairs' distances.
+    pub fn begin_substep(&mut self, previous: &[[f32; 3]], faces: &[[u32; 3]]) {
+        if self.stale {
+            self.rebuild(Ends { from: previous, to: previous }, faces);
+            self.stale = false;
+        } else {
+            self.vertex_triangle.measure(previous, faces);
+            self.edge_edge.measure(previous, &self.edges);
         }
-        let centre = 0.5 * (moved.min + moved.max);
-        let (lo, hi) = (centre - limit, centre + limit);
-        (positions, previous, inverse_mass).into_par_iter().for_each(|(x, p, &w)| {
-            if w > 0.0 {
-                let p = Vec3::from(*p);
-                *x = (p + (Vec3::from(*x) - p).clamp(lo, hi)).to_array();
-            }
-        });
     }
 
-    /// Rebuilds the candidates from `previous` (the last resolved positions) if the frame just
-    /// began or if the motion since the last rebuild, up to `positions`, could have brought a
-    /// left-out pair within h.
-    pub fn refresh(&mut self, positions: &[[f32; 3]], previous: &[[f32; 3]], faces: &[[u32; 3]]) {
-        if !self.stale && spread(positions, &self.reference).extent().length() <= self.budget() {
-            return;
-        }
-        let reach = Reach { distance: self.thickness + self.slack, thickness: self.thickness };
-        self.vertex_triangle.rebuild(previous, faces, reach, &self.neighbours);
-        self.edge_edge.rebuild(previous, &self.edges, reach, &self.neighbours);
-        self.reference.clear();
-        self.reference.extend_from_slice(previous);
-        self.stale = false;
-    }
-
-    /// How far two particles may close between rebuilds, besides the body's push and the other
-    /// constraints' moves.
-    fn budget(&self) -> f32 {
-        SLACK_USE * self.slack - 2.0 * self.body_step
+    fn rebuild(&mut self, ends: Ends, faces: &[[u32; 3]]) {
+        self.vertex_triangle.rebuild(ends, &self.start, faces, self.reach, &self.neighbours);
+        self.edge_edge.rebuild(ends, &self.start, &self.edges, self.reach, &self.neighbours);
     }
 
     /// One pass over the vertex–triangle pairs, then one over the edge–edge pairs. A pair deeper
@@ -125,19 +122,28 @@ impl SelfContacts {
         inverse_mass: &[f32],
         faces: &[[u32; 3]],
     ) {
-        self.vertex_triangle.project(positions, previous, inverse_mass, faces, self.thickness);
-        self.edge_edge.project(positions, previous, inverse_mass, &self.edges, self.thickness);
+        self.vertex_triangle.project(positions, previous, inverse_mass, faces, self.reach.thickness);
+        self.edge_edge.project(positions, previous, inverse_mass, &self.edges, self.reach.thickness);
     }
-}
 
-/// The box around every particle's displacement from `from` to `to`.
-fn spread(to: &[[f32; 3]], from: &[[f32; 3]]) -> Aabb {
-    let empty = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
-    (to, from)
-        .into_par_iter()
-        .map(|(x, p)| {
-            let d = Vec3::from(*x) - Vec3::from(*p);
-            Aabb { min: d, max: d }
-        })
-        .reduce(|| empty, Aabb::union)
+    /// Ends the substep: finds the pairs that can come within reach on the moves from `previous`
+    /// to `positions`, and holds the moves pair by pair ([`SafeStep`]), each particle kept within
+    /// [`ROOM`] of the box around its move so no pair left out can meet.
+    pub fn end_substep(
+        &mut self,
+        positions: &mut [[f32; 3]],
+        previous: &[[f32; 3]],
+        inverse_mass: &[f32],
+        faces: &[[u32; 3]],
+    ) {
+        let ends = Ends { from: previous, to: positions };
+        self.rebuild(ends, faces);
+        let room = ROOM * self.reach.distance;
+        self.room.clear();
+        self.room.extend((0..previous.len() as u32).map(|p| ends.swept(&[p]).inflated(room)));
+        self.closing.clear();
+        self.vertex_triangle.closing(faces, &mut self.closing);
+        self.edge_edge.closing(&self.edges, &mut self.closing);
+        self.step.hold(positions, previous, inverse_mass, &self.closing, &self.room);
+    }
 }

@@ -17,10 +17,17 @@ pub(crate) struct Reach {
     pub thickness: f32,
 }
 
+/// Of two elements' distance in the cloth's start shape, the share their gap may keep: elements
+/// nearer than h there (a gathered waistband, a tight curve) pushed to h would fight the cloth's
+/// own shape and throw it about.
+const START_SHARE: f32 = 0.8;
+
 impl Reach {
-    /// The gap between two elements: h, or a sliver of it when they are `near` neighbours.
-    pub fn gap(&self, near: bool) -> f32 {
-        if near { NEIGHBOUR_GAP * self.thickness } else { self.thickness }
+    /// The gap between two elements `start` apart in the cloth's start shape: h, or a sliver of
+    /// it when they are `near` neighbours, and no more than a share of `start`.
+    pub fn gap(&self, near: bool, start: f32) -> f32 {
+        let gap = if near { NEIGHBOUR_GAP * self.thickness } else { self.thickness };
+        gap.min(START_SHARE * start)
     }
 }
 
@@ -51,4 +58,13 @@ pub(super) fn push_apart(
         let p = &mut positions[particles[k] as usize];
         *p = (Vec3::from(*p) + moves[k] * push).to_array();
     }
+}
+
+/// The farthest any of `particles` has moved from `previous`: a pair can be no nearer than at
+/// the start of the substep less its two sides' farthest moves.
+pub(super) fn moved(positions: &[[f32; 3]], previous: &[[f32; 3]], particles: &[u32]) -> f32 {
+    particles
+        .iter()
+        .map(|&i| Vec3::from(positions[i as usize]).distance(Vec3::from(previous[i as usize])))
+        .fold(0.0, f32::max)
 }

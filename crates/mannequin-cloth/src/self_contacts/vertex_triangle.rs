@@ -1,23 +1,23 @@
 //! Vertex–triangle contacts (Eq. 3.22): a vertex q over a triangle (p₁, p₂, p₃) is kept its gap
 //! from the triangle's plane, C = ±(q − p₁)·n − gap ≥ 0, on the side it belongs on.
 //!
-//! The side is the vertex's side now, unless it passed through the triangle in this substep: when
-//! its side at the start of the substep differs, the moment the four particles were coplanar is
-//! found, and if the vertex was over the triangle then, it went through and belongs on its old
-//! side. Each substep starts from positions where the contacts were resolved, so no side needs
-//! remembering across substeps, and a vertex going round the triangle's edge simply changes side.
+//! The side is the vertex's side at the start of the substep: the safe step keeps it from
+//! passing through, so no side needs remembering across substeps, and a vertex going round the
+//! triangle's edge simply changes side.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::crossing::{between, coplanar_time, volume};
 use super::neighbours::Neighbours;
-use super::push::{Reach, push_apart};
+use super::orientation::volume;
+use super::Ends;
+use super::push::{Reach, moved, push_apart};
+use super::safe_step::Closing;
 use crate::box_hash::{Aabb, BoxHash};
 use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 
 /// A vertex counts as over a triangle while its barycentric coordinates stay above this, so it
-/// cannot slip between two neighbouring triangles through rounding.
+/// is pushed by both neighbouring triangles at their common edge.
 const FOOTPRINT_TOLERANCE: f32 = 1e-3;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,43 +30,80 @@ struct Pair {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct VertexTriangle {
     pairs: Vec<Pair>,
+    /// Each pair's distance at the start of the substep.
+    start: Vec<f32>,
     boxes: Vec<Aabb>,
+    /// Each vertex's box around its move, inflated by half the reach.
+    swept: Vec<Aabb>,
     hash: BoxHash,
 }
 
+/// The distance from `vertex` to the triangle `tri` at `positions`.
+fn distance(positions: &[[f32; 3]], vertex: u32, tri: [u32; 3]) -> f32 {
+    let ([a, b, c], q) = (tri.map(|i| Vec3::from(positions[i as usize])), Vec3::from(positions[vertex as usize]));
+    (q - at_barycentric(closest_barycentric(q, a, b, c), a, b, c)).length()
+}
+
 impl VertexTriangle {
-    /// Every pair within reach at `reference`, the triangle not having the vertex as a corner.
-    pub fn rebuild(&mut self, reference: &[[f32; 3]], faces: &[[u32; 3]], reach: Reach, near: &Neighbours) {
-        let at = |i: u32| Vec3::from(reference[i as usize]);
+    /// Every pair, the triangle not having the vertex as a corner, that can come within reach
+    /// while moving straight from `from` to `to` (their boxes around both, inflated by half the
+    /// reach, overlap, and its distance at `from` less what its moves can close is within
+    /// reach), with its distance at `from`; `initial` is the cloth's start shape, which
+    /// caps each pair's gap.
+    pub fn rebuild(&mut self, ends: Ends, initial: &[[f32; 3]], faces: &[[u32; 3]], reach: Reach, near: &Neighbours) {
+        let half = 0.5 * reach.distance;
+        self.swept.clear();
+        self.swept.extend((0..ends.from.len() as u32).map(|v| ends.swept(&[v]).inflated(half)));
         self.boxes.clear();
-        self.boxes.extend(faces.iter().map(|t| Aabb::around(&t.map(at)).inflated(reach.distance)));
+        self.boxes.extend(faces.iter().map(|t| ends.swept(t).inflated(half)));
         let extents: f32 = self.boxes.iter().map(|b| b.extent().max_element()).sum();
         self.hash.build(&self.boxes, extents / self.boxes.len().max(1) as f32);
-        let (hash, boxes) = (&self.hash, &self.boxes);
-        let found: Vec<Vec<Pair>> = (0..reference.len() as u32)
+        let (hash, boxes, swept) = (&self.hash, &self.boxes, &self.swept);
+        let found: Vec<Vec<(Pair, f32)>> = (0..ends.from.len() as u32)
             .into_par_iter()
             .map(|vertex| {
-                let q = at(vertex);
-                hash.containing(boxes, q)
-                    .filter(|&t| !faces[t as usize].contains(&vertex))
-                    .filter_map(|triangle| {
-                        let tri = faces[triangle as usize];
-                        let [a, b, c] = tri.map(at);
-                        let closest = at_barycentric(closest_barycentric(q, a, b, c), a, b, c);
-                        if (q - closest).length() > reach.distance {
-                            return None;
-                        }
-                        Some(Pair { vertex, triangle, gap: reach.gap(near.touch(&[vertex], &tri)) })
-                    })
-                    .collect()
+                let mut pairs = Vec::new();
+                hash.for_each_overlapping(boxes, &swept[vertex as usize], |triangle| {
+                    let tri = faces[triangle as usize];
+                    if tri.contains(&vertex) {
+                        return;
+                    }
+                    let start = distance(ends.from, vertex, tri);
+                    if start - ends.closing([tri[0], tri[1], tri[2], vertex]) < reach.distance {
+                        let gap = reach.gap(near.touch(&[vertex], &tri), distance(initial, vertex, tri));
+                        pairs.push((Pair { vertex, triangle, gap }, start));
+                    }
+                });
+                pairs
             })
             .collect();
-        self.pairs.clear();
-        self.pairs.extend(found.into_iter().flatten());
+        (self.pairs, self.start) = found.into_iter().flatten().unzip();
+    }
+
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Notes each pair's distance at `positions`, the start of the substep.
+    pub fn measure(&mut self, positions: &[[f32; 3]], faces: &[[u32; 3]]) {
+        self.start.clear();
+        self.start
+            .par_extend(self.pairs.par_iter().map(|pair| distance(positions, pair.vertex, faces[pair.triangle as usize])));
+    }
+
+    /// Each pair's particles, the triangle's corners then the vertex, with its distance at the
+    /// start of the substep.
+    pub fn closing(&self, faces: &[[u32; 3]], out: &mut Vec<Closing>) {
+        out.extend(self.pairs.iter().zip(&self.start).map(|(pair, &distance)| {
+            let [a, b, c] = faces[pair.triangle as usize];
+            ([a, b, c, pair.vertex], distance)
+        }));
     }
 
     /// One Gauss–Seidel pass over the pairs, in their (vertex, triangle) order; `previous` holds
-    /// the positions at the start of the substep.
+    /// the positions at the start of the substep, which say each vertex's side. A vertex over the
+    /// triangle is kept its gap from the plane on its side; one beside it, from the nearest
+    /// point of the triangle's rim, so no pair closes in unseen through its edges.
     pub fn project(
         &self,
         positions: &mut [[f32; 3]],
@@ -75,39 +112,40 @@ impl VertexTriangle {
         faces: &[[u32; 3]],
         most: f32,
     ) {
-        for pair in &self.pairs {
+        for (pair, &start) in self.pairs.iter().zip(&self.start) {
             let tri = faces[pair.triangle as usize];
             let particles = [tri[0], tri[1], tri[2], pair.vertex];
-            let now = particles.map(|i| Vec3::from(positions[i as usize]));
-            let [a, b, c, q] = now;
+            // A pair that cannot be within its gap is skipped before the cost of its closest points.
+            if start - moved(positions, previous, &tri) - moved(positions, previous, &[pair.vertex])
+                >= pair.gap
+            {
+                continue;
+            }
+            let [a, b, c, q] = particles.map(|i| Vec3::from(positions[i as usize]));
             let normal = (b - a).cross(c - a).normalize_or_zero();
             if normal == Vec3::ZERO {
                 continue;
             }
             let height = (q - a).dot(normal);
-            let start = particles.map(|i| Vec3::from(previous[i as usize]));
-            let (before, after) = (volume(start), volume(now));
-            let crossed = before * after < 0.0 && {
-                let [a, b, c, q] = between(start, now, coplanar_time(start, now));
-                over(q, a, b, c)
+            let over = plane_barycentric(q - height * normal, a, b, c);
+            let (bary, direction, distance) = if over.iter().all(|&x| x >= -FOOTPRINT_TOLERANCE) {
+                let side = volume(particles.map(|i| Vec3::from(previous[i as usize]))).signum();
+                (over.map(|x| x.clamp(0.0, 1.0)), side * normal, side * height)
+            } else {
+                let bary = closest_barycentric(q, a, b, c);
+                let away = q - at_barycentric(bary, a, b, c);
+                let distance = away.length();
+                if distance <= f32::MIN_POSITIVE {
+                    continue;
+                }
+                (bary, away / distance, distance)
             };
-            let side = if crossed { before.signum() } else { height.signum() };
-            let bary = plane_barycentric(q - height * normal, a, b, c);
-            if !crossed && bary.iter().any(|&x| x < -FOOTPRINT_TOLERANCE) {
-                continue;
-            }
-            let violation = (side * height - pair.gap).max(-most);
+            let violation = (distance - pair.gap).max(-most);
             if violation >= 0.0 {
                 continue;
             }
-            let bary = bary.map(|x| x.clamp(0.0, 1.0));
             let share = [-bary[0], -bary[1], -bary[2], 1.0];
-            push_apart(positions, particles, inverse_mass, share, -violation * side * normal);
+            push_apart(positions, particles, inverse_mass, share, -violation * direction);
         }
     }
-}
-
-/// Whether `q`, on the plane of (a, b, c), lies over the triangle.
-fn over(q: Vec3, a: Vec3, b: Vec3, c: Vec3) -> bool {
-    plane_barycentric(q, a, b, c).iter().all(|&x| x >= -FOOTPRINT_TOLERANCE)
 }
