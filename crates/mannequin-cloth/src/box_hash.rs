@@ -109,34 +109,6 @@ impl BoxHash {
         }
     }
 
-    /// Calls `visit` once with each box of `boxes` (the ones built from) that overlaps `query`.
-    /// A pair of boxes is reported only from the cell holding the lowest corner of their
-    /// overlap, which both list, so no box is reported twice.
-    pub fn for_each_overlapping(&self, boxes: &[Aabb], query: &Aabb, mut visit: impl FnMut(u32)) {
-        if self.starts.is_empty() {
-            return;
-        }
-        let (lo, hi) = (self.grid.cell_of(query.min), self.grid.cell_of(query.max));
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for x in lo.x..=hi.x {
-                    let cell = IVec3::new(x, y, z);
-                    let h = self.grid.bucket(cell);
-                    let listed = &self.items[self.starts[h] as usize..self.starts[h + 1] as usize];
-                    for (k, &b) in listed.iter().enumerate() {
-                        let other = &boxes[b as usize];
-                        if (k == 0 || listed[k - 1] != b)
-                            && other.overlaps(query)
-                            && self.grid.cell_of(other.min.max(query.min)) == cell
-                        {
-                            visit(b);
-                        }
-                    }
-                }
-            }
-        }
-    }
-
     /// Boxes listed in the bucket of `p`'s cell, in ascending order.
     pub fn query(&self, p: Vec3) -> &[u32] {
         if self.starts.is_empty() {

@@ -10,6 +10,7 @@ mod cloth;
 mod coloured_sweep;
 mod colouring;
 mod constraint_graph;
+mod corner_grid;
 mod dihedral;
 mod error;
 mod garment_check;

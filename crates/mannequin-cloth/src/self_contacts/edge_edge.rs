@@ -9,12 +9,13 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::Ends;
 use super::neighbours::Neighbours;
 use super::orientation::volume;
-use super::Ends;
 use super::push::{Reach, moved, push_apart};
 use super::safe_step::Closing;
-use crate::box_hash::{Aabb, BoxHash};
+use crate::box_hash::Aabb;
+use crate::corner_grid::CornerGrid;
 
 /// Closest points this close to an edge's end (as a fraction of it) count as at the end.
 const END_TOLERANCE: f32 = 1e-3;
@@ -38,7 +39,7 @@ pub(crate) struct EdgeEdge {
     start: Vec<f32>,
     /// Each edge's box around its move, inflated by half the reach.
     swept: Vec<Aabb>,
-    hash: BoxHash,
+    hash: CornerGrid,
 }
 
 /// The closest points of segments p₁p₂ and q₁q₂, as fractions (s, t) along each (Ericson,
@@ -96,11 +97,17 @@ impl EdgeEdge {
     /// overlap, and its distance at `from` less what its moves can close is within reach), with
     /// its distance at `from`; `initial` is the cloth's start shape, which caps
     /// each pair's gap.
-    pub fn rebuild(&mut self, ends: Ends, initial: &[[f32; 3]], edges: &[[u32; 2]], reach: Reach, near: &Neighbours) {
+    pub fn rebuild(
+        &mut self,
+        ends: Ends,
+        initial: &[[f32; 3]],
+        edges: &[[u32; 2]],
+        reach: Reach,
+        near: &Neighbours,
+    ) {
         self.swept.clear();
         self.swept.extend(edges.iter().map(|e| ends.swept(e).inflated(0.5 * reach.distance)));
-        let extents: f32 = self.swept.iter().map(|b| b.extent().max_element()).sum();
-        self.hash.build(&self.swept, extents / self.swept.len().max(1) as f32);
+        self.hash.build(&self.swept);
         let (hash, swept) = (&self.hash, &self.swept);
         let found: Vec<Vec<(Pair, f32)>> = (0..edges.len() as u32)
             .into_par_iter()
@@ -124,17 +131,13 @@ impl EdgeEdge {
         (self.pairs, self.start) = found.into_iter().flatten().unzip();
     }
 
-    pub fn len(&self) -> usize {
-        self.pairs.len()
-    }
-
     /// Notes each pair's distance at `positions`, the start of the substep.
     pub fn measure(&mut self, positions: &[[f32; 3]], edges: &[[u32; 2]]) {
         self.start.clear();
         self.start.par_extend(
-            self.pairs
-                .par_iter()
-                .map(|pair| edge_distance(positions, edges[pair.first as usize], edges[pair.second as usize])),
+            self.pairs.par_iter().map(|pair| {
+                edge_distance(positions, edges[pair.first as usize], edges[pair.second as usize])
+            }),
         );
     }
 

@@ -42,7 +42,9 @@ pub(crate) struct Ends<'a> {
 impl Ends<'_> {
     /// The most the distance between two elements of `particles` can fall along their moves.
     pub fn closing(&self, particles: [u32; 4]) -> f32 {
-        safe_step::closing(particles.map(|p| Vec3::from(self.to[p as usize]) - Vec3::from(self.from[p as usize])))
+        safe_step::closing(
+            particles.map(|p| Vec3::from(self.to[p as usize]) - Vec3::from(self.from[p as usize])),
+        )
     }
 
     /// The box around `particles` at both ends of the move: it holds them all the way.

@@ -55,8 +55,9 @@ impl SafeStep {
         room: &[Aabb],
     ) -> Held {
         self.moves.clear();
-        self.moves
-            .par_extend((&*positions, previous).into_par_iter().map(|(x, p)| Vec3::from(*x) - Vec3::from(*p)));
+        self.moves.par_extend(
+            (&*positions, previous).into_par_iter().map(|(x, p)| Vec3::from(*x) - Vec3::from(*p)),
+        );
         let free = |p: u32| inverse_mass[p as usize] > 0.0;
         let mut held = Held::default();
         for _ in 0..ROUNDS {

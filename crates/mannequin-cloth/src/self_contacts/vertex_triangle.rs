@@ -8,12 +8,13 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::Ends;
 use super::neighbours::Neighbours;
 use super::orientation::volume;
-use super::Ends;
 use super::push::{Reach, moved, push_apart};
 use super::safe_step::Closing;
-use crate::box_hash::{Aabb, BoxHash};
+use crate::box_hash::Aabb;
+use crate::corner_grid::CornerGrid;
 use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 
 /// A vertex counts as over a triangle while its barycentric coordinates stay above this, so it
@@ -35,12 +36,13 @@ pub(crate) struct VertexTriangle {
     boxes: Vec<Aabb>,
     /// Each vertex's box around its move, inflated by half the reach.
     swept: Vec<Aabb>,
-    hash: BoxHash,
+    hash: CornerGrid,
 }
 
 /// The distance from `vertex` to the triangle `tri` at `positions`.
 fn distance(positions: &[[f32; 3]], vertex: u32, tri: [u32; 3]) -> f32 {
-    let ([a, b, c], q) = (tri.map(|i| Vec3::from(positions[i as usize])), Vec3::from(positions[vertex as usize]));
+    let ([a, b, c], q) =
+        (tri.map(|i| Vec3::from(positions[i as usize])), Vec3::from(positions[vertex as usize]));
     (q - at_barycentric(closest_barycentric(q, a, b, c), a, b, c)).length()
 }
 
@@ -50,14 +52,20 @@ impl VertexTriangle {
     /// reach, overlap, and its distance at `from` less what its moves can close is within
     /// reach), with its distance at `from`; `initial` is the cloth's start shape, which
     /// caps each pair's gap.
-    pub fn rebuild(&mut self, ends: Ends, initial: &[[f32; 3]], faces: &[[u32; 3]], reach: Reach, near: &Neighbours) {
+    pub fn rebuild(
+        &mut self,
+        ends: Ends,
+        initial: &[[f32; 3]],
+        faces: &[[u32; 3]],
+        reach: Reach,
+        near: &Neighbours,
+    ) {
         let half = 0.5 * reach.distance;
         self.swept.clear();
         self.swept.extend((0..ends.from.len() as u32).map(|v| ends.swept(&[v]).inflated(half)));
         self.boxes.clear();
         self.boxes.extend(faces.iter().map(|t| ends.swept(t).inflated(half)));
-        let extents: f32 = self.boxes.iter().map(|b| b.extent().max_element()).sum();
-        self.hash.build(&self.boxes, extents / self.boxes.len().max(1) as f32);
+        self.hash.build(&self.boxes);
         let (hash, boxes, swept) = (&self.hash, &self.boxes, &self.swept);
         let found: Vec<Vec<(Pair, f32)>> = (0..ends.from.len() as u32)
             .into_par_iter()
@@ -80,15 +88,12 @@ impl VertexTriangle {
         (self.pairs, self.start) = found.into_iter().flatten().unzip();
     }
 
-    pub fn len(&self) -> usize {
-        self.pairs.len()
-    }
-
     /// Notes each pair's distance at `positions`, the start of the substep.
     pub fn measure(&mut self, positions: &[[f32; 3]], faces: &[[u32; 3]]) {
         self.start.clear();
-        self.start
-            .par_extend(self.pairs.par_iter().map(|pair| distance(positions, pair.vertex, faces[pair.triangle as usize])));
+        self.start.par_extend(
+            self.pairs.par_iter().map(|pair| distance(positions, pair.vertex, faces[pair.triangle as usize])),
+        );
     }
 
     /// Each pair's particles, the triangle's corners then the vertex, with its distance at the
