@@ -1,62 +1,47 @@
-//! A spatial hash that lists each box once, in the cell of its lowest corner, with cells as wide
-//! as the widest box. A box overlapping a query then has its lowest corner within one widest box
-//! below the query's, a block of at most 3 × 3 × 3 cells, and each box is met once. Listing a box
-//! in every cell it covers instead makes a query of a cloth's swept boxes walk hundreds of
-//! entries for the few it keeps.
+//! A spatial hash of boxes for finding overlapping pairs: cells as wide as the boxes are on
+//! average, each box listed in every cell it covers, and an overlapping pair met only in the cell
+//! of its intersection's lowest corner, which both boxes cover, so each pair is met once. Cells as
+//! wide as the widest box instead (one listing a box) make a query of a cloth's swept boxes walk
+//! hundreds of entries for the few it keeps wherever one box is long.
 
-use glam::{IVec3, Vec3};
+use glam::IVec3;
 
-use crate::box_hash::Aabb;
+use crate::box_hash::{Aabb, Grid};
 
 #[derive(Debug, Clone, Default)]
 pub(crate) struct CornerGrid {
-    inverse_cell: f32,
-    widest: Vec3,
-    mask: u32,
-    /// `items[starts[h]..starts[h + 1]]` are the boxes whose lowest corner hashes to bucket h.
+    grid: Grid,
+    /// `entries[starts[h]..starts[h + 1]]` are the (box, cell) listings that hash to bucket h; the
+    /// cell tells a box from another cell's in the same bucket.
     starts: Vec<u32>,
-    items: Vec<u32>,
-    /// Each box's cell, to tell it from another cell's box in the same bucket.
-    cells: Vec<IVec3>,
+    entries: Vec<(u32, IVec3)>,
 }
 
 impl CornerGrid {
-    fn cell_of(&self, p: Vec3) -> IVec3 {
-        (p * self.inverse_cell).floor().as_ivec3()
-    }
-
-    fn bucket(&self, c: IVec3) -> usize {
-        let h = (c.x as u32).wrapping_mul(73_856_093)
-            ^ (c.y as u32).wrapping_mul(19_349_663)
-            ^ (c.z as u32).wrapping_mul(83_492_791);
-        (h & self.mask) as usize
-    }
-
     /// Lists `boxes`, reusing the arrays of the previous build.
     pub fn build(&mut self, boxes: &[Aabb]) {
-        self.widest = boxes.iter().fold(Vec3::ZERO, |w, b| w.max(b.extent()));
-        self.inverse_cell = 1.0 / self.widest.max_element().max(f32::MIN_POSITIVE);
-        let table = (2 * boxes.len()).next_power_of_two().max(1024);
-        self.mask = table as u32 - 1;
-        let cells: Vec<IVec3> = boxes.iter().map(|b| self.cell_of(b.min)).collect();
+        let mean = boxes.iter().map(|b| b.extent().max_element()).sum::<f32>() / boxes.len().max(1) as f32;
+        let table = (4 * boxes.len()).next_power_of_two().max(1024);
+        let grid = Grid { inverse_cell: 1.0 / mean.max(f32::MIN_POSITIVE), mask: table as u32 - 1 };
+        self.grid = grid;
         self.starts.clear();
         self.starts.resize(table + 1, 0);
-        for &c in &cells {
-            let h = self.bucket(c);
-            self.starts[h + 1] += 1;
+        for b in boxes {
+            grid.for_each_cell(b, |c| self.starts[grid.bucket(c) + 1] += 1);
         }
         for h in 0..table {
             self.starts[h + 1] += self.starts[h];
         }
         let mut next = self.starts[..table].to_vec();
-        self.items.clear();
-        self.items.resize(boxes.len(), 0);
-        for (k, &c) in cells.iter().enumerate() {
-            let h = self.bucket(c);
-            self.items[next[h] as usize] = k as u32;
-            next[h] += 1;
+        self.entries.clear();
+        self.entries.resize(self.starts[table] as usize, (0, IVec3::ZERO));
+        for (k, b) in boxes.iter().enumerate() {
+            grid.for_each_cell(b, |c| {
+                let h = grid.bucket(c);
+                self.entries[next[h] as usize] = (k as u32, c);
+                next[h] += 1;
+            });
         }
-        self.cells = cells;
     }
 
     /// Calls `visit` once with each box of `boxes` (the ones built from) that overlaps `query`.
@@ -64,30 +49,27 @@ impl CornerGrid {
         if self.starts.is_empty() {
             return;
         }
-        let (lo, hi) = (self.cell_of(query.min - self.widest), self.cell_of(query.max));
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for x in lo.x..=hi.x {
-                    let cell = IVec3::new(x, y, z);
-                    let h = self.bucket(cell);
-                    for &b in &self.items[self.starts[h] as usize..self.starts[h + 1] as usize] {
-                        if self.cells[b as usize] == cell && boxes[b as usize].overlaps(query) {
-                            visit(b);
-                        }
-                    }
+        let grid = self.grid;
+        grid.for_each_cell(query, |cell| {
+            let h = grid.bucket(cell);
+            for &(b, listed) in &self.entries[self.starts[h] as usize..self.starts[h + 1] as usize] {
+                let other = &boxes[b as usize];
+                if listed == cell && other.overlaps(query) && grid.cell_of(other.min.max(query.min)) == cell {
+                    visit(b);
                 }
             }
-        }
+        });
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     /// Against every pair tested directly: boxes of many sizes, each overlapping box met once.
     #[test]
-    fn finds_exactly_the_overlapping_boxes() {
+    fn finds_exactly_the_overlapping_boxes_once() {
         let boxes: Vec<Aabb> = (0..400)
             .map(|k| {
                 let f = k as f32;

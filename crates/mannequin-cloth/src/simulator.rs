@@ -161,10 +161,15 @@ impl Simulator {
                 self.times.self_contacts += t.elapsed();
             }
         }
-        let t = Instant::now();
         if let Some(contacts) = &mut self.contacts {
-            contacts.end_substep(&mut self.positions, &self.previous, &self.inverse_mass, &self.cloth.faces);
+            let t = Instant::now();
+            contacts.find_candidates(&self.positions, &self.previous, &self.cloth.faces);
+            self.times.hashing += t.elapsed();
+            let t = Instant::now();
+            contacts.hold(&mut self.positions, &self.previous, &self.inverse_mass, &self.cloth.faces);
+            self.times.self_contacts += t.elapsed();
         }
+        let t = Instant::now();
         self.update_velocities(dt);
         self.times.prediction += t.elapsed();
     }

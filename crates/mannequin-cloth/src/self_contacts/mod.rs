@@ -27,10 +27,7 @@ use vertex_triangle::VertexTriangle;
 
 /// The slack s is this many thicknesses: the contacts of one substep are the pairs that came
 /// within h + s in the one before, so a wider reach catches faster pairs but holds more.
-const THICKNESS_SLACK: f32 = 0.5;
-/// How far past the box around its move the safe step may draw a particle, as a share of the
-/// reach: under half, so a pair left out stays apart.
-const ROOM: f32 = 0.25;
+const THICKNESS_SLACK: f32 = 0.2;
 
 /// Where a substep's moves start and end.
 #[derive(Debug, Clone, Copy)]
@@ -51,7 +48,7 @@ impl Ends<'_> {
     pub fn swept(&self, particles: &[u32]) -> Aabb {
         let at = |k: usize| {
             let p = particles[k / 2] as usize;
-            Vec3::from(if k % 2 == 0 { self.from[p] } else { self.to[p] })
+            Vec3::from(if k.is_multiple_of(2) { self.from[p] } else { self.to[p] })
         };
         (1..2 * particles.len()).fold(Aabb { min: at(0), max: at(0) }, |b, k| {
             let x = at(k);
@@ -128,10 +125,17 @@ impl SelfContacts {
         self.edge_edge.project(positions, previous, inverse_mass, &self.edges, self.reach.thickness);
     }
 
-    /// Ends the substep: finds the pairs that can come within reach on the moves from `previous`
-    /// to `positions`, and holds the moves pair by pair ([`SafeStep`]), each particle kept within
-    /// [`ROOM`] of the box around its move so no pair left out can meet.
-    pub fn end_substep(
+    /// Ends the substep, first: finds the pairs that can come within reach on the moves from
+    /// `previous` to `positions`.
+    pub fn find_candidates(&mut self, positions: &[[f32; 3]], previous: &[[f32; 3]], faces: &[[u32; 3]]) {
+        self.rebuild(Ends { from: previous, to: positions }, faces);
+    }
+
+    /// Ends the substep, second: holds the moves from `previous` to `positions` pair by pair
+    /// ([`SafeStep`]), each particle kept within the box around its own move: the moves of
+    /// pairs left out of the candidates then stay within what they were checked for, and a
+    /// particle stays on the side of a flat floor that both ends of its move are on.
+    pub fn hold(
         &mut self,
         positions: &mut [[f32; 3]],
         previous: &[[f32; 3]],
@@ -139,10 +143,8 @@ impl SelfContacts {
         faces: &[[u32; 3]],
     ) {
         let ends = Ends { from: previous, to: positions };
-        self.rebuild(ends, faces);
-        let room = ROOM * self.reach.distance;
         self.room.clear();
-        self.room.extend((0..previous.len() as u32).map(|p| ends.swept(&[p]).inflated(room)));
+        self.room.extend((0..previous.len() as u32).map(|p| ends.swept(&[p])));
         self.closing.clear();
         self.vertex_triangle.closing(faces, &mut self.closing);
         self.edge_edge.closing(&self.edges, &mut self.closing);

@@ -40,12 +40,18 @@ pub(super) struct Held {
 pub(super) struct SafeStep {
     moves: Vec<Vec3>,
     sums: Vec<(Vec3, u32)>,
+    /// `incident[starts[p]..starts[p + 1]]` are the pairs with particle p.
+    starts: Vec<u32>,
+    incident: Vec<u32>,
+    /// The round in which each pair was last queued, so it is queued once a round.
+    queued: Vec<usize>,
 }
 
 impl SafeStep {
     /// Pulls the moves from `previous` to `positions` back until no pair of `pairs` can close
     /// by more than [`SHARE`] of its start distance; kinematic particles (inverse mass 0) keep
-    /// their moves, and every free particle ends within its `room`, which holds its start.
+    /// their moves, and every free particle ends within its `room`, which holds its start. After
+    /// one pass over every pair, only the pairs of particles a round moved are looked at again.
     pub fn hold(
         &mut self,
         positions: &mut [[f32; 3]],
@@ -59,64 +65,104 @@ impl SafeStep {
             (&*positions, previous).into_par_iter().map(|(x, p)| Vec3::from(*x) - Vec3::from(*p)),
         );
         let free = |p: u32| inverse_mass[p as usize] > 0.0;
+        let spreads = |moves: &[Vec3], (particles, distance): &Closing| {
+            particles.iter().any(|&p| free(p))
+                && closing(particles.map(|p| moves[p as usize])) >= SHARE * distance
+        };
+        let mut spreading: Vec<u32> = (0..pairs.len() as u32)
+            .into_par_iter()
+            .filter(|&k| spreads(&self.moves, &pairs[k as usize]))
+            .collect();
         let mut held = Held::default();
-        for _ in 0..ROUNDS {
-            let spreading = self.spreading(pairs, inverse_mass);
-            if spreading.is_empty() {
-                break;
-            }
+        if spreading.is_empty() {
+            return held;
+        }
+        self.index_incident(pairs, previous.len());
+        for round in 1..=ROUNDS {
             self.sums.clear();
             self.sums.resize(self.moves.len(), (Vec3::ZERO, 0));
             for &k in &spreading {
-                let (particles, _) = pairs[k];
+                let (particles, _) = pairs[k as usize];
                 let mean = particles.iter().map(|&p| self.moves[p as usize]).sum::<Vec3>() / 4.0;
                 for p in particles.into_iter().filter(|&p| free(p)) {
                     let sum = &mut self.sums[p as usize];
                     *sum = (sum.0 + mean, sum.1 + 1);
                 }
             }
+            let mut moved = Vec::new();
             for (p, (m, &(sum, count))) in self.moves.iter_mut().zip(&self.sums).enumerate() {
                 if count > 0 {
                     let start = Vec3::from(previous[p]);
                     *m = (start + sum / count as f32).clamp(room[p].min, room[p].max) - start;
-                    held.drawn += 1;
+                    moved.push(p as u32);
                 }
             }
-        }
-        loop {
-            let mut stopped = false;
-            for k in self.spreading(pairs, inverse_mass) {
-                for p in pairs[k].0.into_iter().filter(|&p| free(p)) {
-                    if self.moves[p as usize] != Vec3::ZERO {
-                        self.moves[p as usize] = Vec3::ZERO;
-                        held.stopped += 1;
-                        stopped = true;
-                    }
-                }
-            }
-            if !stopped {
+            held.drawn += moved.len();
+            spreading = self.incident_to(&moved, round);
+            spreading.retain(|&k| spreads(&self.moves, &pairs[k as usize]));
+            if spreading.is_empty() {
                 break;
             }
         }
-        if held != Held::default() {
-            (positions, previous, &self.moves).into_par_iter().for_each(|(x, p, m)| {
-                *x = (Vec3::from(*p) + *m).to_array();
-            });
+        // Stopping a pair's free particles may make its neighbours spread: follow them until
+        // none does.
+        let mut round = ROUNDS + 1;
+        while !spreading.is_empty() {
+            let mut stopped = Vec::new();
+            for &k in &spreading {
+                for p in pairs[k as usize].0.into_iter().filter(|&p| free(p)) {
+                    if self.moves[p as usize] != Vec3::ZERO {
+                        self.moves[p as usize] = Vec3::ZERO;
+                        stopped.push(p);
+                    }
+                }
+            }
+            held.stopped += stopped.len();
+            round += 1;
+            spreading = self.incident_to(&stopped, round);
+            spreading.retain(|&k| spreads(&self.moves, &pairs[k as usize]));
         }
+        (positions, previous, &self.moves).into_par_iter().for_each(|(x, p, m)| {
+            *x = (Vec3::from(*p) + *m).to_array();
+        });
         held
     }
 
-    /// The pairs, with a free particle, whose moves spread too far for their start distance.
-    fn spreading(&self, pairs: &[Closing], inverse_mass: &[f32]) -> Vec<usize> {
-        pairs
-            .par_iter()
-            .enumerate()
-            .filter(|(_, (particles, distance))| {
-                particles.iter().any(|&p| inverse_mass[p as usize] > 0.0)
-                    && closing(particles.map(|p| self.moves[p as usize])) >= SHARE * distance
-            })
-            .map(|(k, _)| k)
-            .collect()
+    /// Lists each particle's pairs.
+    fn index_incident(&mut self, pairs: &[Closing], particles: usize) {
+        self.starts.clear();
+        self.starts.resize(particles + 1, 0);
+        for &p in pairs.iter().flat_map(|(ps, _)| ps) {
+            self.starts[p as usize + 1] += 1;
+        }
+        for p in 0..particles {
+            self.starts[p + 1] += self.starts[p];
+        }
+        let mut next = self.starts[..particles].to_vec();
+        self.incident.clear();
+        self.incident.resize(self.starts[particles] as usize, 0);
+        for (k, (ps, _)) in pairs.iter().enumerate() {
+            for &p in ps {
+                self.incident[next[p as usize] as usize] = k as u32;
+                next[p as usize] += 1;
+            }
+        }
+        self.queued.clear();
+        self.queued.resize(pairs.len(), 0);
+    }
+
+    /// The pairs with any of `particles`, each once, marked as queued in `round`.
+    fn incident_to(&mut self, particles: &[u32], round: usize) -> Vec<u32> {
+        let mut out = Vec::new();
+        for &p in particles {
+            for &k in &self.incident[self.starts[p as usize] as usize..self.starts[p as usize + 1] as usize] {
+                if self.queued[k as usize] != round {
+                    self.queued[k as usize] = round;
+                    out.push(k);
+                }
+            }
+        }
+        out
     }
 }
 
