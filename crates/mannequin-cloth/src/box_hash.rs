@@ -44,37 +44,32 @@ impl Aabb {
 
 /// Grid cells hashed into a table of `mask + 1` buckets.
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Grid {
-    pub inverse_cell: f32,
-    pub mask: u32,
+struct Grid {
+    inverse_cell: f32,
+    mask: u32,
 }
 
 impl Grid {
-    pub fn cell_of(&self, p: Vec3) -> IVec3 {
+    fn cell_of(&self, p: Vec3) -> IVec3 {
         (p * self.inverse_cell).floor().as_ivec3()
     }
 
-    pub fn bucket(&self, c: IVec3) -> usize {
+    fn bucket(&self, c: IVec3) -> usize {
         let h = (c.x as u32).wrapping_mul(73_856_093)
             ^ (c.y as u32).wrapping_mul(19_349_663)
             ^ (c.z as u32).wrapping_mul(83_492_791);
         (h & self.mask) as usize
     }
 
-    /// Calls `visit` with each cell `b` covers.
-    pub fn for_each_cell(&self, b: &Aabb, mut visit: impl FnMut(IVec3)) {
+    fn for_each_bucket(&self, b: &Aabb, mut visit: impl FnMut(usize)) {
         let (lo, hi) = (self.cell_of(b.min), self.cell_of(b.max));
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 for x in lo.x..=hi.x {
-                    visit(IVec3::new(x, y, z));
+                    visit(self.bucket(IVec3::new(x, y, z)));
                 }
             }
         }
-    }
-
-    fn for_each_bucket(&self, b: &Aabb, mut visit: impl FnMut(usize)) {
-        self.for_each_cell(b, |c| visit(self.bucket(c)));
     }
 }
 

@@ -15,7 +15,7 @@ use super::orientation::volume;
 use super::push::{Reach, moved, push_apart};
 use super::safe_step::Closing;
 use crate::box_hash::Aabb;
-use crate::corner_grid::CornerGrid;
+use crate::box_tree::BoxTree;
 
 /// Closest points this close to an edge's end (as a fraction of it) count as at the end.
 const END_TOLERANCE: f32 = 1e-3;
@@ -39,7 +39,7 @@ pub(crate) struct EdgeEdge {
     start: Vec<f32>,
     /// Each edge's box around its move, inflated by half the reach.
     swept: Vec<Aabb>,
-    hash: CornerGrid,
+    tree: BoxTree,
 }
 
 /// The closest points of segments p₁p₂ and q₁q₂, as fractions (s, t) along each (Ericson,
@@ -107,28 +107,25 @@ impl EdgeEdge {
     ) {
         self.swept.clear();
         self.swept.extend(edges.iter().map(|e| ends.swept(e).inflated(0.5 * reach.distance)));
-        self.hash.build(&self.swept);
-        let (hash, swept) = (&self.hash, &self.swept);
-        let found: Vec<Vec<(Pair, f32)>> = (0..edges.len() as u32)
+        self.tree.refit(&self.swept);
+        let found: Vec<(Pair, f32)> = self
+            .tree
+            .overlapping_pairs(&self.tree)
             .into_par_iter()
-            .map(|first| {
-                let e1 = edges[first as usize];
-                let mut pairs = Vec::new();
-                hash.for_each_overlapping(swept, &swept[first as usize], |second| {
-                    let e2 = edges[second as usize];
-                    if second <= first || e2.iter().any(|v| e1.contains(v)) {
-                        return;
-                    }
-                    let start = edge_distance(ends.from, e1, e2);
-                    if start - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < reach.distance {
-                        let gap = reach.gap(near.touch(&e1, &e2), edge_distance(initial, e1, e2));
-                        pairs.push((Pair { first, second, gap }, start));
-                    }
-                });
-                pairs
+            .filter_map(|(a, b)| {
+                let (first, second) = (a.min(b), a.max(b));
+                let (e1, e2) = (edges[first as usize], edges[second as usize]);
+                if e2.iter().any(|v| e1.contains(v)) {
+                    return None;
+                }
+                let start = edge_distance(ends.from, e1, e2);
+                (start - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < reach.distance).then(|| {
+                    let gap = reach.gap(near.touch(&e1, &e2), edge_distance(initial, e1, e2));
+                    (Pair { first, second, gap }, start)
+                })
             })
             .collect();
-        (self.pairs, self.start) = found.into_iter().flatten().unzip();
+        (self.pairs, self.start) = found.into_iter().unzip();
     }
 
     /// Notes each pair's distance at `positions`, the start of the substep.

@@ -14,7 +14,7 @@ use super::orientation::volume;
 use super::push::{Reach, moved, push_apart};
 use super::safe_step::Closing;
 use crate::box_hash::Aabb;
-use crate::corner_grid::CornerGrid;
+use crate::box_tree::BoxTree;
 use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 
 /// A vertex counts as over a triangle while its barycentric coordinates stay above this, so it
@@ -36,7 +36,9 @@ pub(crate) struct VertexTriangle {
     boxes: Vec<Aabb>,
     /// Each vertex's box around its move, inflated by half the reach.
     swept: Vec<Aabb>,
-    hash: CornerGrid,
+    /// Trees over the triangles' and the vertices' boxes.
+    tree: BoxTree,
+    vertices: BoxTree,
 }
 
 /// The distance from `vertex` to the triangle `tri` at `positions`.
@@ -65,27 +67,25 @@ impl VertexTriangle {
         self.swept.extend((0..ends.from.len() as u32).map(|v| ends.swept(&[v]).inflated(half)));
         self.boxes.clear();
         self.boxes.extend(faces.iter().map(|t| ends.swept(t).inflated(half)));
-        self.hash.build(&self.boxes);
-        let (hash, boxes, swept) = (&self.hash, &self.boxes, &self.swept);
-        let found: Vec<Vec<(Pair, f32)>> = (0..ends.from.len() as u32)
+        self.tree.refit(&self.boxes);
+        self.vertices.refit(&self.swept);
+        let found: Vec<(Pair, f32)> = self
+            .vertices
+            .overlapping_pairs(&self.tree)
             .into_par_iter()
-            .map(|vertex| {
-                let mut pairs = Vec::new();
-                hash.for_each_overlapping(boxes, &swept[vertex as usize], |triangle| {
-                    let tri = faces[triangle as usize];
-                    if tri.contains(&vertex) {
-                        return;
-                    }
-                    let start = distance(ends.from, vertex, tri);
-                    if start - ends.closing([tri[0], tri[1], tri[2], vertex]) < reach.distance {
-                        let gap = reach.gap(near.touch(&[vertex], &tri), distance(initial, vertex, tri));
-                        pairs.push((Pair { vertex, triangle, gap }, start));
-                    }
-                });
-                pairs
+            .filter_map(|(vertex, triangle)| {
+                let tri = faces[triangle as usize];
+                if tri.contains(&vertex) {
+                    return None;
+                }
+                let start = distance(ends.from, vertex, tri);
+                (start - ends.closing([tri[0], tri[1], tri[2], vertex]) < reach.distance).then(|| {
+                    let gap = reach.gap(near.touch(&[vertex], &tri), distance(initial, vertex, tri));
+                    (Pair { vertex, triangle, gap }, start)
+                })
             })
             .collect();
-        (self.pairs, self.start) = found.into_iter().flatten().unzip();
+        (self.pairs, self.start) = found.into_iter().unzip();
     }
 
     /// Notes each pair's distance at `positions`, the start of the substep.
