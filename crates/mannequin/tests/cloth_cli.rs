@@ -143,8 +143,8 @@ fn a_skirt_walks_with_the_body() {
     std::fs::remove_dir_all(dir).ok();
 }
 
-/// `--self-collision` keeps the skirt's folds apart: no self-intersecting triangle pairs at any
-/// frame, where the same run without it has some.
+/// Self-collision (on by default) keeps the skirt's folds apart: no self-intersecting triangle
+/// pairs at any frame, where the same run with `--no-self-collision` has some.
 #[test]
 fn self_collision_keeps_the_folds_apart() {
     let dir = scratch("cloth-skirt-self");
@@ -161,7 +161,7 @@ fn self_collision_keeps_the_folds_apart() {
         assert_eq!(metrics["max_vertices_inside_body"], 0, "{metrics}");
         metrics["max_self_intersecting_pairs"].as_u64().unwrap()
     };
-    let (with, without) = (pairs(&["--self-collision"]), pairs(&[]));
+    let (with, without) = (pairs(&[]), pairs(&["--no-self-collision"]));
     assert!(with == 0 && without > 0, "{with} pairs with self-collision, {without} without");
     std::fs::remove_dir_all(dir).ok();
 }

@@ -23,8 +23,8 @@ pub struct DressSettings {
     /// Skin the garments only (Eqs. 3.2–3.3), without the cloth simulator.
     #[arg(long = "no-simulation")]
     pub no_simulation: bool,
-    /// Cloth–cloth contacts within each garment (vertex–triangle and edge–edge); slow, see
-    /// `cloth simulate --self-collision`.
+    /// Cloth–cloth contacts within each garment (vertex–triangle and edge–edge), as `cloth
+    /// simulate` has by default; off here until they also hold the layers apart.
     #[arg(long = "self-collision")]
     pub self_collision: bool,
     /// Save a checkpoint every this many simulated frames (0: never); a re-run of the same
