@@ -9,7 +9,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::Ends;
+use super::ends::Ends;
 use super::neighbours::Neighbours;
 use super::orientation::volume;
 use super::push::{Reach, moved, push_apart};

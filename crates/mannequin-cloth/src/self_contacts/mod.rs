@@ -10,16 +10,16 @@
 //! frame to the next, so a saved state of positions and velocities resumes the same run.
 
 mod edge_edge;
+mod ends;
 mod neighbours;
 mod orientation;
 mod push;
 mod safe_step;
 mod vertex_triangle;
 
-use glam::Vec3;
-
 use crate::box_hash::Aabb;
 use edge_edge::EdgeEdge;
+use ends::Ends;
 use neighbours::Neighbours;
 use push::Reach;
 use safe_step::{Closing, SafeStep};
@@ -28,34 +28,6 @@ use vertex_triangle::VertexTriangle;
 /// The slack s is this many thicknesses: the contacts of one substep are the pairs that came
 /// within h + s in the one before, so a wider reach catches faster pairs but holds more.
 const THICKNESS_SLACK: f32 = 0.2;
-
-/// Where a substep's moves start and end.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Ends<'a> {
-    pub from: &'a [[f32; 3]],
-    pub to: &'a [[f32; 3]],
-}
-
-impl Ends<'_> {
-    /// The most the distance between two elements of `particles` can fall along their moves.
-    pub fn closing(&self, particles: [u32; 4]) -> f32 {
-        safe_step::closing(
-            particles.map(|p| Vec3::from(self.to[p as usize]) - Vec3::from(self.from[p as usize])),
-        )
-    }
-
-    /// The box around `particles` at both ends of the move: it holds them all the way.
-    pub fn swept(&self, particles: &[u32]) -> Aabb {
-        let at = |k: usize| {
-            let p = particles[k / 2] as usize;
-            Vec3::from(if k.is_multiple_of(2) { self.from[p] } else { self.to[p] })
-        };
-        (1..2 * particles.len()).fold(Aabb { min: at(0), max: at(0) }, |b, k| {
-            let x = at(k);
-            Aabb { min: b.min.min(x), max: b.max.max(x) }
-        })
-    }
-}
 
 #[derive(Debug)]
 pub(crate) struct SelfContacts {
