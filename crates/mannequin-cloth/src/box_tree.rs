@@ -31,12 +31,14 @@ fn spread(x: u32) -> u32 {
 }
 
 impl BoxTree {
-    /// Refits the tree to `boxes`, one per element; on the first call, or when the number of
-    /// elements changes, orders the leaves by where the boxes are.
+    /// Whether the leaves are in order for `elements` elements.
+    pub fn is_ordered_for(&self, elements: usize) -> bool {
+        self.order.len() == elements && elements > 0
+    }
+
+    /// Refits the tree to `boxes`, one per element of those the leaves were ordered for.
     pub fn refit(&mut self, boxes: &[Aabb]) {
-        if self.order.len() != boxes.len() {
-            self.order_leaves(boxes);
-        }
+        debug_assert_eq!(self.order.len(), boxes.len(), "the leaves are ordered for other elements");
         for (k, &e) in self.order.iter().enumerate() {
             self.nodes[self.leaves + k] = boxes[e as usize];
         }
@@ -45,7 +47,9 @@ impl BoxTree {
         }
     }
 
-    fn order_leaves(&mut self, boxes: &[Aabb]) {
+    /// Orders the leaves along a Morton curve through `boxes`, one per element: a cloth's start
+    /// shape, so that a run resumed from a checkpoint walks its pairs in the same order.
+    pub fn order_leaves(&mut self, boxes: &[Aabb]) {
         let centre = |b: &Aabb| 0.5 * (b.min + b.max);
         let all = boxes.iter().fold(EMPTY, |a, b| a.union(*b));
         let scale = 1023.0 / all.extent().max_element().max(f32::MIN_POSITIVE);
@@ -141,6 +145,10 @@ mod tests {
         let (mut tree, mut other) = (BoxTree::default(), BoxTree::default());
         for shift in [0.0, 1.3] {
             let (boxes, others) = (scattered(403, shift), scattered(77, shift + 0.4));
+            if shift == 0.0 {
+                tree.order_leaves(&boxes);
+                other.order_leaves(&others);
+            }
             tree.refit(&boxes);
             other.refit(&others);
             let mut found: Vec<(u32, u32)> =

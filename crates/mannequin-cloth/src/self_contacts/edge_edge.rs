@@ -107,6 +107,10 @@ impl EdgeEdge {
     ) {
         self.swept.clear();
         self.swept.extend(edges.iter().map(|e| ends.swept(e).inflated(0.5 * reach.distance)));
+        if !self.tree.is_ordered_for(edges.len()) {
+            let start = Ends { from: initial, to: initial };
+            self.tree.order_leaves(&edges.iter().map(|e| start.swept(e)).collect::<Vec<_>>());
+        }
         self.tree.refit(&self.swept);
         let found: Vec<(Pair, f32)> = self
             .tree

@@ -67,6 +67,12 @@ impl VertexTriangle {
         self.swept.extend((0..ends.from.len() as u32).map(|v| ends.swept(&[v]).inflated(half)));
         self.boxes.clear();
         self.boxes.extend(faces.iter().map(|t| ends.swept(t).inflated(half)));
+        if !self.tree.is_ordered_for(faces.len()) {
+            let start = Ends { from: initial, to: initial };
+            self.tree.order_leaves(&faces.iter().map(|t| start.swept(t)).collect::<Vec<_>>());
+            self.vertices
+                .order_leaves(&(0..initial.len() as u32).map(|v| start.swept(&[v])).collect::<Vec<_>>());
+        }
         self.tree.refit(&self.boxes);
         self.vertices.refit(&self.swept);
         let found: Vec<(Pair, f32)> = self
