@@ -7,7 +7,7 @@
 //!    solver is timed on the same grids in the same run and the ratio printed.
 //! 2. The issue's target: a 10k-particle garment (a tube around the hips, its top ring attached
 //!    to the body) on the default body walking, with self-collision and body collision, per
-//!    1/30 s frame (target ≤ 33 ms on 2 cores), and the process's peak memory.
+//!    1/30 s frame (issue 38's target: ≤ 100 ms on 2 cores), and the process's peak memory.
 //!
 //! `cargo bench -p mannequin-cloth --bench cloth [-- --frames N]`
 
@@ -24,6 +24,9 @@ mod common;
 #[path = "../../../tools/bench_args.rs"]
 mod bench_args;
 use bench_args::arg;
+
+/// The walking garment's target per 1/30 s frame on 2 cores (issue 38).
+const TARGET_MS: f64 = 100.0;
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
@@ -156,9 +159,9 @@ fn walking_garment(frames: usize) {
         garment.vertex_count()
     );
     println!(
-        "  {per_frame:.1} ms per frame over {walked} walking frames; target ≤ 33 ms: {} (ratio target / ours {:.2})",
-        if per_frame <= 33.0 { "met" } else { "NOT met" },
-        33.0 / per_frame
+        "  {per_frame:.1} ms per frame over {walked} walking frames; target ≤ {TARGET_MS} ms: {} (ratio target / ours {:.2})",
+        if per_frame <= TARGET_MS { "met" } else { "NOT met" },
+        TARGET_MS / per_frame
     );
     let (all, before) = (sim.phase_times(), settled);
     let walk = PhaseTimes {
