@@ -5,14 +5,10 @@
 /// left both are 0.
 pub fn edge_strain(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]]) -> (f32, f32) {
     let edges = mannequin_mesh::adjacency::edges(faces);
-    let length = |p: &[[f32; 3]], [a, b]: [u32; 2]| -> Option<f64> {
-        let (a, b) = (p.get(a as usize)?, p.get(b as usize)?);
-        Some((0..3).map(|k| (a[k] as f64 - b[k] as f64).powi(2)).sum::<f64>().sqrt())
-    };
     let strains: Vec<f64> = edges
         .iter()
         .filter_map(|&e| {
-            let (l0, l) = (length(rest, e)?, length(current, e)?);
+            let (l0, l) = (edge_length(rest, e)?, edge_length(current, e)?);
             (l0 > 0.0).then(|| (l / l0 - 1.0).abs())
         })
         .collect();
@@ -23,17 +19,19 @@ pub fn edge_strain(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]]) 
     (max as f32, (strains.iter().sum::<f64>() / strains.len() as f64) as f32)
 }
 
+/// The length of edge (a, b) at `p`, in double precision; `None` for an index out of range.
+fn edge_length(p: &[[f32; 3]], [a, b]: [u32; 2]) -> Option<f64> {
+    let (a, b) = (p.get(a as usize)?, p.get(b as usize)?);
+    Some((0..3).map(|k| (a[k] as f64 - b[k] as f64).powi(2)).sum::<f64>().sqrt())
+}
+
 /// The `q` quantile (0–1) of the edges' stretch max(l/l₀ − 1, 0): how far the most stretched
 /// edges are past their rest length, ignoring compression (cloth buckles rather than resists it).
 pub fn stretch_quantile(rest: &[[f32; 3]], current: &[[f32; 3]], faces: &[[u32; 3]], q: f64) -> f32 {
     let mut stretch: Vec<f64> = mannequin_mesh::adjacency::edges(faces)
         .iter()
-        .filter_map(|&[a, b]| {
-            let length = |p: &[[f32; 3]]| -> Option<f64> {
-                let (a, b) = (p.get(a as usize)?, p.get(b as usize)?);
-                Some((0..3).map(|k| (a[k] as f64 - b[k] as f64).powi(2)).sum::<f64>().sqrt())
-            };
-            let (l0, l) = (length(rest)?, length(current)?);
+        .filter_map(|&e| {
+            let (l0, l) = (edge_length(rest, e)?, edge_length(current, e)?);
             (l0 > 0.0).then(|| (l / l0 - 1.0).max(0.0))
         })
         .collect();
