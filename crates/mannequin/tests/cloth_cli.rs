@@ -120,6 +120,11 @@ fn a_skirt_walks_with_the_body() {
     // (0.50 at most here, without self-collision the folds pass through each other).
     assert!(metrics["mean_edge_strain"].as_f64().unwrap() < 0.05, "{metrics}");
     assert!(metrics["max_edge_strain"].as_f64().unwrap() < 1.0, "{metrics}");
+    // The p99 stretch is reported beside the limit of the fabric it is held to (an .obj is cotton).
+    let cotton = mannequin_cloth::Material::named("cotton").unwrap().strain_limit;
+    assert_eq!(metrics["strain_limit"].as_f64().unwrap() as f32, cotton, "{metrics}");
+    let p99 = metrics["max_p99_edge_stretch"].as_f64().unwrap();
+    assert!(p99 > 0.0 && p99 <= metrics["max_edge_strain"].as_f64().unwrap(), "{metrics}");
 
     // The attached waist stays on the walking body: within 2 cm of where its rest binding puts it,
     // which moves with the hips (the walk's root moves several cm over the clip).

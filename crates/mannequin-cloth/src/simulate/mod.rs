@@ -80,6 +80,8 @@ pub struct Simulation {
     garment: TriMesh,
     progress: Progress,
     phases: PhaseTimes,
+    /// The material's strain limit, which the stretch is measured against.
+    strain_limit: f32,
     stopped: Option<SimulateError>,
     checkpoint: PathBuf,
 }
@@ -188,7 +190,15 @@ pub fn simulate(
         Err(e) if progress.frames.is_empty() => return Err(e),
         outcome => outcome.err(),
     };
-    Ok(Simulation { garment: garment.clone(), progress, phases: sim.phase_times(), stopped, checkpoint })
+    let strain_limit = sim.cloth().material.strain_limit;
+    Ok(Simulation {
+        garment: garment.clone(),
+        progress,
+        phases: sim.phase_times(),
+        strain_limit,
+        stopped,
+        checkpoint,
+    })
 }
 
 impl Simulation {
@@ -197,16 +207,18 @@ impl Simulation {
     pub fn write(&self, dir: &Path, out: &Path, job: &SimulateJob) -> Result<(), SimulateError> {
         let body = (job.performer.model, job.performer.betas, job.performer.motion);
         let frames = &self.progress.frames;
-        let summary =
-            outputs::write_outputs(dir, &self.garment, body, frames, &self.progress.metrics, &self.phases)?;
+        let metrics = (self.progress.metrics.as_slice(), self.strain_limit);
+        let summary = outputs::write_outputs(dir, &self.garment, body, frames, metrics, &self.phases)?;
         let f = frames.len();
         tracing::info!(
-            "wrote {}: {f} frames of {} vertices; {:.1} ms per frame; at most {} vertices inside the body, {} self-intersecting pairs",
+            "wrote {}: {f} frames of {} vertices; {:.1} ms per frame; at most {} vertices inside the body, {} self-intersecting pairs, p99 stretch {:.1} % (limit {:.1} %)",
             out.display(),
             self.garment.vertex_count(),
             summary["ms_per_frame"].as_f64().unwrap_or(0.0),
             summary["max_vertices_inside_body"],
             summary["max_self_intersecting_pairs"],
+            100.0 * summary["max_p99_edge_stretch"].as_f64().unwrap_or(0.0),
+            100.0 * self.strain_limit,
         );
         Ok(())
     }

@@ -13,13 +13,14 @@ use crate::phase_times::PhaseTimes;
 use crate::simulate_error::SimulateError;
 
 /// The four outputs for `frames` of `garment` on `model` (shape `betas`) playing `motion`, into
-/// `dir`; returns the metrics' summary.
+/// `dir`, with the frames' `metrics` beside the material's `strain_limit`; returns the metrics'
+/// summary.
 pub(super) fn write_outputs(
     dir: &Path,
     garment: &TriMesh,
     (model, betas, motion): (&BodyModel, &[f32], &Motion),
     frames: &[Vec<[f32; 3]>],
-    metrics: &[FrameMetrics],
+    (metrics, strain_limit): (&[FrameMetrics], f32),
     phases: &PhaseTimes,
 ) -> Result<serde_json::Value, SimulateError> {
     let (f, v) = (frames.len(), garment.vertex_count());
@@ -53,6 +54,8 @@ pub(super) fn write_outputs(
         "max_self_intersecting_pairs": m.iter().map(|x| x.self_intersecting_pairs).max(),
         "max_edge_strain": m.iter().map(|x| x.max_edge_strain).fold(0.0f32, f32::max),
         "mean_edge_strain": m.iter().map(|x| x.mean_edge_strain).sum::<f32>() / f as f32,
+        "max_p99_edge_stretch": m.iter().map(|x| x.p99_edge_stretch).fold(0.0f32, f32::max),
+        "strain_limit": strain_limit,
         "simulation_s": total_ms / 1e3,
         "ms_per_frame": total_ms / f as f64,
         "phase_s": phases,
