@@ -108,7 +108,7 @@ impl Simulator {
         }
         let dt = frame_dt / substeps as f32;
         for k in 0..substeps {
-            self.substep(k, dt);
+            self.substep(k, dt, (substeps - k) as f32 * dt);
         }
         match self.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
             Some(particle) => Err(ClothError::NonFinite { particle }),
@@ -116,7 +116,8 @@ impl Simulator {
         }
     }
 
-    fn substep(&mut self, k: u32, dt: f32) {
+    /// Substep `k` of `dt`, `remaining` of the frame left (its own included).
+    fn substep(&mut self, k: u32, dt: f32, remaining: f32) {
         if let Some(body) = &mut self.body {
             let t = Instant::now();
             body.advance(k);
@@ -126,14 +127,15 @@ impl Simulator {
                 self.times.hashing += t.elapsed();
             }
         }
+        // Before the prediction, which stills the attached particles' velocities.
+        if let Some(contacts) = &mut self.contacts {
+            let t = Instant::now();
+            contacts.begin_substep(&self.positions, &self.velocities, (dt, remaining), &self.cloth.faces);
+            self.times.hashing += t.elapsed();
+        }
         let t = Instant::now();
         self.predict(dt);
         self.times.prediction += t.elapsed();
-        if let Some(contacts) = &mut self.contacts {
-            let t = Instant::now();
-            contacts.begin_substep(&self.previous, &self.cloth.faces);
-            self.times.hashing += t.elapsed();
-        }
         self.stretch_lambda.fill(0.0);
         self.bending_lambda.fill(0.0);
         let w = &self.inverse_mass;

@@ -9,13 +9,14 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::anchor::Anchor;
 use super::ends::Ends;
-use super::neighbours::Neighbours;
 use super::orientation::volume;
-use super::push::{Reach, moved, push_apart};
+use super::push::{moved, push_apart};
 use super::safe_step::Closing;
+use super::search::Search;
 use crate::box_hash::Aabb;
-use crate::box_tree::BoxTree;
+use crate::box_tree::{BoxTree, MovingBox};
 
 /// Closest points this close to an edge's end (as a fraction of it) count as at the end.
 const END_TOLERANCE: f32 = 1e-3;
@@ -32,12 +33,23 @@ struct Pair {
     gap: f32,
 }
 
+/// A pair watched through a frame, with its distance d₀ at the anchor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Watched {
+    first: u32,
+    second: u32,
+    distance: f32,
+}
+
 #[derive(Debug, Clone, Default)]
 pub(crate) struct EdgeEdge {
     pairs: Vec<Pair>,
     /// Each pair's distance at the start of the substep.
     start: Vec<f32>,
-    /// Each edge's box around its move, inflated by half the reach.
+    watched: Vec<Watched>,
+    /// Each edge's box.
+    boxes: Vec<MovingBox>,
+    /// The box around each edge's move, grown by half the reach.
     swept: Vec<Aabb>,
     tree: BoxTree,
 }
@@ -91,45 +103,107 @@ fn edge_distance(positions: &[[f32; 3]], e1: [u32; 2], e2: [u32; 2]) -> f32 {
     (p1 + s * (p2 - p1)).distance(q1 + t * (q2 - q1))
 }
 
+/// The pair of edges `a` and `b` with its distance at the start of the substep `ends`, if they
+/// share no vertex and that distance less what the moves can close is within reach.
+fn admit(ends: Ends, search: Search<[u32; 2]>, a: u32, b: u32) -> Option<(Pair, f32)> {
+    let (first, second) = (a.min(b), a.max(b));
+    let (e1, e2) = (search.elements[first as usize], search.elements[second as usize]);
+    if e2.iter().any(|v| e1.contains(v)) {
+        return None;
+    }
+    let start = edge_distance(ends.from, e1, e2);
+    (start - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < search.reach.distance).then(|| {
+        let gap = search.reach.gap(search.near.touch(&e1, &e2), edge_distance(search.initial, e1, e2));
+        (Pair { first, second, gap }, start)
+    })
+}
+
 impl EdgeEdge {
-    /// Every pair of edges without a common vertex that can come within reach while moving
-    /// straight from `from` to `to` (their boxes around both, inflated by half the reach,
-    /// overlap, and its distance at `from` less what its moves can close is within reach), with
-    /// its distance at `from`; `initial` is the cloth's start shape, which caps
-    /// each pair's gap.
-    pub fn rebuild(
+    /// Refits the tree to the edges' boxes, ordering its leaves first by `initial`, the cloth's
+    /// start shape, and walks it for the pairs that may come within `reach` within `horizon`.
+    fn meeting(
         &mut self,
-        ends: Ends,
         initial: &[[f32; 3]],
         edges: &[[u32; 2]],
-        reach: Reach,
-        near: &Neighbours,
-    ) {
-        self.swept.clear();
-        self.swept.extend(edges.iter().map(|e| ends.swept(e).inflated(0.5 * reach.distance)));
+        horizon: f32,
+        reach: f32,
+    ) -> Vec<(u32, u32)> {
         if !self.tree.is_ordered_for(edges.len()) {
             let start = Ends { from: initial, to: initial };
             self.tree.order_leaves(&edges.iter().map(|e| start.swept(e)).collect::<Vec<_>>());
         }
-        self.tree.refit(&self.swept);
-        let found: Vec<(Pair, f32)> = self
-            .tree
-            .overlapping_pairs(&self.tree)
+        self.tree.refit(&self.boxes);
+        self.tree.meeting_pairs(&self.tree, horizon, reach)
+    }
+
+    /// Watches, from `anchor` to its horizon, every pair of edges without a common vertex whose
+    /// boxes may come within reach while no particle strays farther than the allowance from its
+    /// predicted path.
+    pub fn watch(&mut self, anchor: &Anchor, search: Search<[u32; 2]>) {
+        let edges = search.elements;
+        self.boxes.clear();
+        self.boxes.extend(edges.iter().map(|e| anchor.moving(e)));
+        let pairs = self.meeting(search.initial, edges, anchor.horizon, search.reach.distance);
+        self.watched = pairs
             .into_par_iter()
             .filter_map(|(a, b)| {
                 let (first, second) = (a.min(b), a.max(b));
                 let (e1, e2) = (edges[first as usize], edges[second as usize]);
-                if e2.iter().any(|v| e1.contains(v)) {
-                    return None;
-                }
-                let start = edge_distance(ends.from, e1, e2);
-                (start - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < reach.distance).then(|| {
-                    let gap = reach.gap(near.touch(&e1, &e2), edge_distance(initial, e1, e2));
-                    (Pair { first, second, gap }, start)
-                })
+                let distance = edge_distance(anchor.places(), e1, e2);
+                (!e2.iter().any(|v| e1.contains(v))).then_some(Watched { first, second, distance })
             })
             .collect();
-        (self.pairs, self.start) = found.into_iter().unzip();
+    }
+
+    /// The pairs of the substep `ends` that [`admit`] takes among those whose boxes around the
+    /// moves come within reach: of those watched from `anchor`, and those with a particle that
+    /// strayed, found afresh. A watched pair whose distance at the anchor, less how far its
+    /// particles have moved apart since and what the moves can close, is beyond reach is passed
+    /// over without its closest points.
+    pub fn find(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 2]>) {
+        let half = 0.5 * search.reach.distance;
+        self.swept.clear();
+        self.swept.extend(search.elements.iter().map(|e| ends.swept(e).inflated(half)));
+        let swept = &self.swept;
+        let near = |w: &&Watched| {
+            let (e1, e2) = (search.elements[w.first as usize], search.elements[w.second as usize]);
+            let particles = [e1[0], e1[1], e2[0], e2[1]];
+            !anchor.strayed(&particles)
+                && swept[w.first as usize].overlaps(&swept[w.second as usize])
+                && w.distance - anchor.apart(&e1, &e2) - ends.closing(particles) < search.reach.distance
+        };
+        let mut kept: Vec<(Pair, f32)> = self
+            .watched
+            .par_iter()
+            .filter(near)
+            .filter_map(|w| admit(ends, search, w.first, w.second))
+            .collect();
+        if anchor.any_strayed() {
+            kept.extend(self.strays(ends, anchor, search));
+        }
+        (self.pairs, self.start) = kept.into_iter().unzip();
+    }
+
+    /// The pairs with a particle that strayed from its path, whose boxes around the moves come
+    /// within reach, that [`admit`] takes: each edge with a strayed end against every edge, a pair
+    /// of two such edges once.
+    fn strays(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 2]>) -> Vec<(Pair, f32)> {
+        let edges = search.elements;
+        self.boxes.clear();
+        self.boxes.extend(edges.iter().map(|e| MovingBox::still(ends.swept(e))));
+        self.tree.refit(&self.boxes);
+        let (boxes, tree, reach) = (&self.boxes, &self.tree, search.reach.distance);
+        let strayed = |e: u32| anchor.strayed(&edges[e as usize]);
+        (0..edges.len() as u32)
+            .into_par_iter()
+            .filter(|&e| strayed(e))
+            .flat_map_iter(|e| {
+                let mut found = Vec::new();
+                tree.near(&boxes[e as usize], reach, &mut found);
+                found.into_iter().filter(move |&f| f != e && (e < f || !strayed(f))).map(move |f| (e, f))
+            })
+            .filter_map(|(e, f)| admit(ends, search, e, f))
+            .collect()
     }
 
     /// Notes each pair's distance at `positions`, the start of the substep.

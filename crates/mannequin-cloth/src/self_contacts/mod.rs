@@ -2,27 +2,33 @@
 //! thickness h between the cloth's layers on the side each pair was on at the start of the
 //! substep, and a safe step that keeps any pair from passing through in between.
 //!
-//! Candidate pairs come from spatial hashes of the boxes each element sweeps in a substep,
-//! inflated by half the reach h + s: a pair left out stays farther apart than that reach over the
-//! whole move, so only candidates need holding ([`SafeStep`]), and their distances at the end of
-//! one substep are the next substep's contacts. The hashes are built once per substep, at its end,
-//! and once at the start of every frame from where the cloth is: nothing is remembered from one
-//! frame to the next, so a saved state of positions and velocities resumes the same run.
+//! Candidate pairs come from trees over the boxes of the elements: a pair left out stays farther
+//! apart than the reach h + s over the whole move, so only candidates need holding
+//! ([`SafeStep`]), and their distances at the end of one substep are the next substep's contacts.
+//! The trees are walked once every few substeps, for every pair that can come within reach while
+//! each particle keeps near its predicted path ([`Anchor`]), and each substep takes from those the
+//! pairs its moves bring within reach; the pairs of a particle that strayed from its path are
+//! looked for afresh in the trees until the next anchor. Every frame anchors first where the
+//! cloth is and how it moves, so a saved state of positions and velocities resumes the same run.
 
+mod anchor;
 mod edge_edge;
 mod ends;
 mod neighbours;
 mod orientation;
 mod push;
 mod safe_step;
+mod search;
 mod vertex_triangle;
 
 use crate::box_hash::Aabb;
+use anchor::Anchor;
 use edge_edge::EdgeEdge;
 use ends::Ends;
 use neighbours::Neighbours;
 use push::Reach;
 use safe_step::{Closing, SafeStep};
+use search::Search;
 use vertex_triangle::VertexTriangle;
 
 /// The slack s is this many thicknesses: the contacts of one substep are the pairs that came
@@ -41,6 +47,7 @@ pub(crate) struct SelfContacts {
     closing: Vec<Closing>,
     room: Vec<Aabb>,
     reach: Reach,
+    anchor: Anchor,
     stale: bool,
 }
 
@@ -57,30 +64,40 @@ impl SelfContacts {
             closing: Vec::new(),
             room: Vec::new(),
             reach: Reach { distance: (1.0 + THICKNESS_SLACK) * thickness, thickness },
+            anchor: Anchor::default(),
             stale: true,
         }
     }
 
-    /// Starts a frame: the candidates are found afresh at its first substep.
+    /// Starts a frame: it anchors afresh at its first substep.
     pub fn begin_frame(&mut self) {
         self.stale = true;
     }
 
-    /// Starts a substep from `previous` (the last resolved positions): finds the pairs within
-    /// reach there if the frame just began, else notes the last substep's pairs' distances.
-    pub fn begin_substep(&mut self, previous: &[[f32; 3]], faces: &[[u32; 3]]) {
-        if self.stale {
-            self.rebuild(Ends { from: previous, to: previous }, faces);
+    /// Starts a substep of `dt` from `positions`, moving at `velocities`, with `remaining` of the
+    /// frame left (this substep's included): anchors there if due, and finds the pairs within
+    /// reach, else notes the last substep's pairs' distances.
+    pub fn begin_substep(
+        &mut self,
+        positions: &[[f32; 3]],
+        velocities: &[[f32; 3]],
+        (dt, remaining): (f32, f32),
+        faces: &[[u32; 3]],
+    ) {
+        if self.stale || self.anchor.is_spent() {
+            let search =
+                Search { initial: &self.start, elements: faces, reach: self.reach, near: &self.neighbours };
+            self.anchor.set(positions, velocities, remaining, dt);
+            self.vertex_triangle.watch(&self.anchor, search);
+            self.edge_edge.watch(&self.anchor, search.over(&self.edges));
+            let still = Ends { from: positions, to: positions };
+            self.vertex_triangle.find(still, &self.anchor, search);
+            self.edge_edge.find(still, &self.anchor, search.over(&self.edges));
             self.stale = false;
         } else {
-            self.vertex_triangle.measure(previous, faces);
-            self.edge_edge.measure(previous, &self.edges);
+            self.vertex_triangle.measure(positions, faces);
+            self.edge_edge.measure(positions, &self.edges);
         }
-    }
-
-    fn rebuild(&mut self, ends: Ends, faces: &[[u32; 3]]) {
-        self.vertex_triangle.rebuild(ends, &self.start, faces, self.reach, &self.neighbours);
-        self.edge_edge.rebuild(ends, &self.start, &self.edges, self.reach, &self.neighbours);
     }
 
     /// One pass over the vertex–triangle pairs, then one over the edge–edge pairs. A pair deeper
@@ -98,9 +115,15 @@ impl SelfContacts {
     }
 
     /// Ends the substep, first: finds the pairs that can come within reach on the moves from
-    /// `previous` to `positions`.
+    /// `previous` to `positions`, among those watched, and afresh for the particles that strayed
+    /// from their predicted paths.
     pub fn find_candidates(&mut self, positions: &[[f32; 3]], previous: &[[f32; 3]], faces: &[[u32; 3]]) {
-        self.rebuild(Ends { from: previous, to: positions }, faces);
+        let ends = Ends { from: previous, to: positions };
+        let search =
+            Search { initial: &self.start, elements: faces, reach: self.reach, near: &self.neighbours };
+        self.anchor.advance(ends);
+        self.vertex_triangle.find(ends, &self.anchor, search);
+        self.edge_edge.find(ends, &self.anchor, search.over(&self.edges));
     }
 
     /// Ends the substep, second: holds the moves from `previous` to `positions` pair by pair

@@ -8,13 +8,14 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::anchor::Anchor;
 use super::ends::Ends;
-use super::neighbours::Neighbours;
 use super::orientation::volume;
-use super::push::{Reach, moved, push_apart};
+use super::push::{moved, push_apart};
 use super::safe_step::Closing;
+use super::search::Search;
 use crate::box_hash::Aabb;
-use crate::box_tree::BoxTree;
+use crate::box_tree::{BoxTree, MovingBox};
 use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric, plane_barycentric};
 
 /// A vertex counts as over a triangle while its barycentric coordinates stay above this, so it
@@ -28,14 +29,26 @@ struct Pair {
     gap: f32,
 }
 
+/// A pair watched through a frame, with its distance d₀ at the anchor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Watched {
+    vertex: u32,
+    triangle: u32,
+    distance: f32,
+}
+
 #[derive(Debug, Clone, Default)]
 pub(crate) struct VertexTriangle {
     pairs: Vec<Pair>,
     /// Each pair's distance at the start of the substep.
     start: Vec<f32>,
-    boxes: Vec<Aabb>,
-    /// Each vertex's box around its move, inflated by half the reach.
+    watched: Vec<Watched>,
+    boxes: Vec<MovingBox>,
+    /// Each vertex's box.
+    points: Vec<MovingBox>,
+    /// The boxes around each triangle's and each vertex's move, grown by half the reach.
     swept: Vec<Aabb>,
+    swept_points: Vec<Aabb>,
     /// Trees over the triangles' and the vertices' boxes.
     tree: BoxTree,
     vertices: BoxTree,
@@ -48,25 +61,29 @@ fn distance(positions: &[[f32; 3]], vertex: u32, tri: [u32; 3]) -> f32 {
     (q - at_barycentric(closest_barycentric(q, a, b, c), a, b, c)).length()
 }
 
+/// The pair of `vertex` and `triangle` with its distance at the start of the substep `ends`, if
+/// that distance less what the moves can close is within reach.
+fn admit(ends: Ends, search: Search<[u32; 3]>, vertex: u32, triangle: u32) -> Option<(Pair, f32)> {
+    let tri = search.elements[triangle as usize];
+    let start = distance(ends.from, vertex, tri);
+    (start - ends.closing([tri[0], tri[1], tri[2], vertex]) < search.reach.distance).then(|| {
+        let near = search.near.touch(&[vertex], &tri);
+        let gap = search.reach.gap(near, distance(search.initial, vertex, tri));
+        (Pair { vertex, triangle, gap }, start)
+    })
+}
+
 impl VertexTriangle {
-    /// Every pair, the triangle not having the vertex as a corner, that can come within reach
-    /// while moving straight from `from` to `to` (their boxes around both, inflated by half the
-    /// reach, overlap, and its distance at `from` less what its moves can close is within
-    /// reach), with its distance at `from`; `initial` is the cloth's start shape, which
-    /// caps each pair's gap.
-    pub fn rebuild(
+    /// Refits the trees to the triangles' `boxes` and the vertices' `points`, ordering their
+    /// leaves first by `initial`, the cloth's start shape, and walks them for the pairs that may
+    /// come within `reach` within `horizon`, the triangle not having the vertex as a corner.
+    fn meeting(
         &mut self,
-        ends: Ends,
         initial: &[[f32; 3]],
         faces: &[[u32; 3]],
-        reach: Reach,
-        near: &Neighbours,
-    ) {
-        let half = 0.5 * reach.distance;
-        self.swept.clear();
-        self.swept.extend((0..ends.from.len() as u32).map(|v| ends.swept(&[v]).inflated(half)));
-        self.boxes.clear();
-        self.boxes.extend(faces.iter().map(|t| ends.swept(t).inflated(half)));
+        horizon: f32,
+        reach: f32,
+    ) -> Vec<(u32, u32)> {
         if !self.tree.is_ordered_for(faces.len()) {
             let start = Ends { from: initial, to: initial };
             self.tree.order_leaves(&faces.iter().map(|t| start.swept(t)).collect::<Vec<_>>());
@@ -74,24 +91,97 @@ impl VertexTriangle {
                 .order_leaves(&(0..initial.len() as u32).map(|v| start.swept(&[v])).collect::<Vec<_>>());
         }
         self.tree.refit(&self.boxes);
-        self.vertices.refit(&self.swept);
-        let found: Vec<(Pair, f32)> = self
-            .vertices
-            .overlapping_pairs(&self.tree)
+        self.vertices.refit(&self.points);
+        let mut pairs = self.vertices.meeting_pairs(&self.tree, horizon, reach);
+        pairs.retain(|&(vertex, triangle)| !faces[triangle as usize].contains(&vertex));
+        pairs
+    }
+
+    /// Watches, from `anchor` to its horizon, every pair whose boxes may come within reach
+    /// while no particle strays farther than the allowance from its predicted path.
+    pub fn watch(&mut self, anchor: &Anchor, search: Search<[u32; 3]>) {
+        let (initial, faces) = (search.initial, search.elements);
+        self.boxes.clear();
+        self.boxes.extend(faces.iter().map(|t| anchor.moving(t)));
+        self.points.clear();
+        self.points.extend((0..initial.len() as u32).map(|v| anchor.moving(&[v])));
+        let pairs = self.meeting(initial, faces, anchor.horizon, search.reach.distance);
+        self.watched = pairs
             .into_par_iter()
-            .filter_map(|(vertex, triangle)| {
-                let tri = faces[triangle as usize];
-                if tri.contains(&vertex) {
-                    return None;
-                }
-                let start = distance(ends.from, vertex, tri);
-                (start - ends.closing([tri[0], tri[1], tri[2], vertex]) < reach.distance).then(|| {
-                    let gap = reach.gap(near.touch(&[vertex], &tri), distance(initial, vertex, tri));
-                    (Pair { vertex, triangle, gap }, start)
-                })
+            .map(|(vertex, triangle)| {
+                let distance = distance(anchor.places(), vertex, faces[triangle as usize]);
+                Watched { vertex, triangle, distance }
             })
             .collect();
-        (self.pairs, self.start) = found.into_iter().unzip();
+    }
+
+    /// The pairs of the substep `ends` that [`admit`] takes among those whose boxes around the
+    /// moves come within reach: of those watched from `anchor`, and those with a particle that
+    /// strayed, found afresh. A watched pair whose distance at the anchor, less how far its
+    /// particles have moved apart since and what the moves can close, is beyond reach is passed
+    /// over without its closest points.
+    pub fn find(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 3]>) {
+        let half = 0.5 * search.reach.distance;
+        self.swept.clear();
+        self.swept.extend(search.elements.iter().map(|t| ends.swept(t).inflated(half)));
+        self.swept_points.clear();
+        self.swept_points.extend((0..ends.from.len() as u32).map(|v| ends.swept(&[v]).inflated(half)));
+        let (swept, points) = (&self.swept, &self.swept_points);
+        let near = |w: &&Watched| {
+            let tri = search.elements[w.triangle as usize];
+            let [a, b, c] = tri;
+            !anchor.strayed(&[a, b, c, w.vertex])
+                && points[w.vertex as usize].overlaps(&swept[w.triangle as usize])
+                && w.distance - anchor.apart(&[w.vertex], &tri) - ends.closing([a, b, c, w.vertex])
+                    < search.reach.distance
+        };
+        let mut kept: Vec<(Pair, f32)> = self
+            .watched
+            .par_iter()
+            .filter(near)
+            .filter_map(|w| admit(ends, search, w.vertex, w.triangle))
+            .collect();
+        if anchor.any_strayed() {
+            kept.extend(self.strays(ends, anchor, search));
+        }
+        (self.pairs, self.start) = kept.into_iter().unzip();
+    }
+
+    /// The pairs with a particle that strayed from its path, whose boxes around the moves come
+    /// within reach, that [`admit`] takes: each strayed vertex against every triangle, and each
+    /// triangle with a strayed corner against every vertex that did not stray.
+    fn strays(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 3]>) -> Vec<(Pair, f32)> {
+        let faces = search.elements;
+        self.boxes.clear();
+        self.boxes.extend(faces.iter().map(|t| MovingBox::still(ends.swept(t))));
+        self.points.clear();
+        self.points.extend((0..ends.from.len() as u32).map(|v| MovingBox::still(ends.swept(&[v]))));
+        self.tree.refit(&self.boxes);
+        self.vertices.refit(&self.points);
+        let (boxes, points, reach) = (&self.boxes, &self.points, search.reach.distance);
+        let (triangles, vertices) = (&self.tree, &self.vertices);
+        let near = |tree: &BoxTree, query: &MovingBox| {
+            let mut found = Vec::new();
+            tree.near(query, reach, &mut found);
+            found
+        };
+        let from_vertices = (0..points.len() as u32)
+            .into_par_iter()
+            .filter(|&v| anchor.strayed(&[v]))
+            .flat_map_iter(|v| near(triangles, &points[v as usize]).into_iter().map(move |t| (v, t)));
+        let from_triangles = (0..faces.len() as u32)
+            .into_par_iter()
+            .filter(|&t| anchor.strayed(&faces[t as usize]))
+            .flat_map_iter(|t| {
+                let others =
+                    near(vertices, &boxes[t as usize]).into_iter().filter(|&v| !anchor.strayed(&[v]));
+                others.map(move |v| (v, t))
+            });
+        from_vertices
+            .chain(from_triangles)
+            .filter(|&(v, t)| !faces[t as usize].contains(&v))
+            .filter_map(|(v, t)| admit(ends, search, v, t))
+            .collect()
     }
 
     /// Notes each pair's distance at `positions`, the start of the substep.
