@@ -16,7 +16,7 @@ pub struct SimulateSettings {
     #[serde(flatten)]
     pub stepping: Stepping,
     /// Turn off the cloth–cloth contacts (vertex–triangle, Eq. 3.22, and edge–edge), which keep
-    /// every triangle pair from crossing; off, the cloth runs about 4× faster but its folds may
+    /// every triangle pair from crossing; off, the cloth runs 2.5–3× faster but its folds may
     /// pass through each other. metrics.json counts the self-intersecting pairs either way.
     #[arg(long = "no-self-collision", action = clap::ArgAction::SetFalse)]
     pub self_collision: bool,
