@@ -75,8 +75,9 @@ impl SelfContacts {
     }
 
     /// Starts a substep of `dt` from `positions`, moving at `velocities`, with `remaining` of the
-    /// frame left (this substep's included): anchors there if due, and finds the pairs within
-    /// reach, else notes the last substep's pairs' distances.
+    /// frame left (this substep's included): anchors there if due. At a frame's start it finds
+    /// the pairs within reach; else it notes the distances of the pairs the last substep found,
+    /// which include those its moves were bringing near.
     pub fn begin_substep(
         &mut self,
         positions: &[[f32; 3]],
@@ -84,12 +85,14 @@ impl SelfContacts {
         (dt, remaining): (f32, f32),
         faces: &[[u32; 3]],
     ) {
+        let search =
+            Search { initial: &self.start, elements: faces, reach: self.reach, near: &self.neighbours };
         if self.stale || self.anchor.is_spent() {
-            let search =
-                Search { initial: &self.start, elements: faces, reach: self.reach, near: &self.neighbours };
             self.anchor.set(positions, velocities, remaining, dt);
             self.vertex_triangle.watch(&self.anchor, search);
             self.edge_edge.watch(&self.anchor, search.over(&self.edges));
+        }
+        if self.stale {
             let still = Ends { from: positions, to: positions };
             self.vertex_triangle.find(still, &self.anchor, search);
             self.edge_edge.find(still, &self.anchor, search.over(&self.edges));
