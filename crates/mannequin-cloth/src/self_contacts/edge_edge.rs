@@ -10,6 +10,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::anchor::Anchor;
+use super::apart::Apart;
 use super::ends::Ends;
 use super::orientation::volume;
 use super::push::{moved, push_apart};
@@ -44,8 +45,8 @@ struct Watched {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct EdgeEdge {
     pairs: Vec<Pair>,
-    /// Each pair's distance at the start of the substep.
-    start: Vec<f32>,
+    /// How far apart each pair is at the start of the substep.
+    start: Vec<Apart>,
     watched: Vec<Watched>,
     /// Each edge's box.
     boxes: Vec<MovingBox>,
@@ -96,24 +97,25 @@ fn inside(x: f32) -> bool {
     x > END_TOLERANCE && x < 1.0 - END_TOLERANCE
 }
 
-/// The distance between the closest points of edges `e1` and `e2` at `positions`.
-fn edge_distance(positions: &[[f32; 3]], e1: [u32; 2], e2: [u32; 2]) -> f32 {
+/// How far apart edges `e1` and `e2` are at `positions`, `e1` first.
+fn edges_apart(positions: &[[f32; 3]], e1: [u32; 2], e2: [u32; 2]) -> Apart {
     let [p1, p2, q1, q2] = [e1[0], e1[1], e2[0], e2[1]].map(|i| Vec3::from(positions[i as usize]));
     let (s, t) = closest_fractions(p1, p2, q1, q2);
-    (p1 + s * (p2 - p1)).distance(q1 + t * (q2 - q1))
+    Apart::between(p1 + s * (p2 - p1), q1 + t * (q2 - q1))
 }
 
 /// The pair of edges `a` and `b` with its distance at the start of the substep `ends`, if they
 /// share no vertex and that distance less what the moves can close is within reach.
-fn admit(ends: Ends, search: Search<[u32; 2]>, a: u32, b: u32) -> Option<(Pair, f32)> {
+fn admit(ends: Ends, search: Search<[u32; 2]>, a: u32, b: u32) -> Option<(Pair, Apart)> {
     let (first, second) = (a.min(b), a.max(b));
     let (e1, e2) = (search.elements[first as usize], search.elements[second as usize]);
     if e2.iter().any(|v| e1.contains(v)) {
         return None;
     }
-    let start = edge_distance(ends.from, e1, e2);
-    (start - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < search.reach.distance).then(|| {
-        let gap = search.reach.gap(search.near.touch(&e1, &e2), edge_distance(search.initial, e1, e2));
+    let start = edges_apart(ends.from, e1, e2);
+    (start.distance - ends.closing([e1[0], e1[1], e2[0], e2[1]]) < search.reach.distance).then(|| {
+        let initial = edges_apart(search.initial, e1, e2).distance;
+        let gap = search.reach.gap(search.near.touch(&e1, &e2), initial);
         (Pair { first, second, gap }, start)
     })
 }
@@ -149,7 +151,7 @@ impl EdgeEdge {
             .filter_map(|(a, b)| {
                 let (first, second) = (a.min(b), a.max(b));
                 let (e1, e2) = (edges[first as usize], edges[second as usize]);
-                let distance = edge_distance(anchor.places(), e1, e2);
+                let distance = edges_apart(anchor.places(), e1, e2).distance;
                 (!e2.iter().any(|v| e1.contains(v))).then_some(Watched { first, second, distance })
             })
             .collect();
@@ -172,7 +174,7 @@ impl EdgeEdge {
                 && swept[w.first as usize].overlaps(&swept[w.second as usize])
                 && w.distance - anchor.apart(&e1, &e2) - ends.closing(particles) < search.reach.distance
         };
-        let mut kept: Vec<(Pair, f32)> = self
+        let mut kept: Vec<(Pair, Apart)> = self
             .watched
             .par_iter()
             .filter(near)
@@ -187,7 +189,7 @@ impl EdgeEdge {
     /// The pairs with a particle that strayed from its path, whose boxes around the moves come
     /// within reach, that [`admit`] takes: each edge with a strayed end against every edge, a pair
     /// of two such edges once.
-    fn strays(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 2]>) -> Vec<(Pair, f32)> {
+    fn strays(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 2]>) -> Vec<(Pair, Apart)> {
         let edges = search.elements;
         self.boxes.clear();
         self.boxes.extend(edges.iter().map(|e| MovingBox::still(ends.swept(e))));
@@ -206,22 +208,22 @@ impl EdgeEdge {
             .collect()
     }
 
-    /// Notes each pair's distance at `positions`, the start of the substep.
+    /// Notes how far apart each pair is at `positions`, the start of the substep.
     pub fn measure(&mut self, positions: &[[f32; 3]], edges: &[[u32; 2]]) {
         self.start.clear();
         self.start.par_extend(
-            self.pairs.par_iter().map(|pair| {
-                edge_distance(positions, edges[pair.first as usize], edges[pair.second as usize])
-            }),
+            self.pairs
+                .par_iter()
+                .map(|pair| edges_apart(positions, edges[pair.first as usize], edges[pair.second as usize])),
         );
     }
 
-    /// Each pair's particles, the first edge's ends then the second's, with its distance at the
-    /// start of the substep.
+    /// Each pair's particles, the first edge's ends then the second's, with how far apart they
+    /// are at the start of the substep.
     pub fn closing(&self, edges: &[[u32; 2]], out: &mut Vec<Closing>) {
-        out.extend(self.pairs.iter().zip(&self.start).map(|(pair, &distance)| {
+        out.extend(self.pairs.iter().zip(&self.start).map(|(pair, &apart)| {
             let ([a, b], [c, d]) = (edges[pair.first as usize], edges[pair.second as usize]);
-            ([a, b, c, d], distance)
+            Closing { particles: [a, b, c, d], split: 2, apart }
         }));
     }
 
@@ -237,10 +239,12 @@ impl EdgeEdge {
         edges: &[[u32; 2]],
         most: f32,
     ) {
-        for (pair, &start) in self.pairs.iter().zip(&self.start) {
+        for (pair, start) in self.pairs.iter().zip(&self.start) {
             let (first, second) = (edges[pair.first as usize], edges[pair.second as usize]);
             // A pair that cannot be within its gap is skipped before the cost of its closest points.
-            if start - moved(positions, previous, &first) - moved(positions, previous, &second) >= pair.gap {
+            if start.distance - moved(positions, previous, &first) - moved(positions, previous, &second)
+                >= pair.gap
+            {
                 continue;
             }
             let ([a, b], [c, d]) = (first, second);

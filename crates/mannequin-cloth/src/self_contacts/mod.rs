@@ -12,6 +12,7 @@
 //! cloth is and how it moves, so a saved state of positions and velocities resumes the same run.
 
 mod anchor;
+mod apart;
 mod edge_edge;
 mod ends;
 mod neighbours;

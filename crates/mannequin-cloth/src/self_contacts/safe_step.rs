@@ -11,10 +11,16 @@
 //! particles), each kept within its room (near the box around its own move, so that pairs left
 //! out of the candidates stay apart); what still spreads too far after that is stopped where it
 //! started the substep, and so on until nothing does, which stopping everything free achieves.
+//!
+//! The spread bounds how far a pair can close, not whether it does: a pair pushed apart spreads
+//! as much as one driven through. So a pair also passes whose elements' projections on the line
+//! between their closest points at the start stay apart by the same share at the end ([`Apart`]):
+//! they are apart all the way, and a pair squeezed close can always be pushed apart again.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::apart::Apart;
 use crate::box_hash::Aabb;
 
 /// Of a pair's start distance, the most its moves may close it by in one substep.
@@ -22,16 +28,37 @@ const SHARE: f32 = 0.8;
 /// Rounds of drawing the moves of pairs that spread too far to their pairs' means.
 const ROUNDS: usize = 8;
 
-/// One pair: its four particles (a vertex and a triangle's corners, or two edges' ends) and its
-/// distance at the start of the substep.
-pub(super) type Closing = ([u32; 4], f32);
+/// One pair: its four particles, `particles[..split]` the first element's (a triangle's corners,
+/// or an edge's ends) and the rest the second's (a vertex, or the other edge's ends), and how far
+/// apart they are at the start of the substep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Closing {
+    pub particles: [u32; 4],
+    pub split: usize,
+    pub apart: Apart,
+}
+
+impl Closing {
+    /// True when the moves `moves` of the pair's particles from `previous` could bring it nearer
+    /// than [`SHARE`] allows: they spread more than that, and the pair's projections on its
+    /// axis end nearer than the rest of the start distance.
+    fn spreads(&self, previous: &[[f32; 3]], moves: &[Vec3]) -> bool {
+        let m = self.particles.map(|p| moves[p as usize]);
+        if closing(m) < SHARE * self.apart.distance {
+            return false;
+        }
+        let ends = [0, 1, 2, 3].map(|k| Vec3::from(previous[self.particles[k] as usize]) + m[k]);
+        let gap = self.apart.along_axis(ends, self.split);
+        !(gap > 0.0 && gap >= (1.0 - SHARE) * self.apart.distance)
+    }
+}
 
 /// What making a substep safe did.
 #[derive(Debug, Default, Clone, Copy, PartialEq)]
 pub(super) struct Held {
     /// Particles whose moves were drawn to their pairs' means.
     pub drawn: usize,
-    /// Particles set to the cloth's mean move.
+    /// Particles stopped where they started the substep.
     pub stopped: usize,
 }
 
@@ -65,9 +92,8 @@ impl SafeStep {
             (&*positions, previous).into_par_iter().map(|(x, p)| Vec3::from(*x) - Vec3::from(*p)),
         );
         let free = |p: u32| inverse_mass[p as usize] > 0.0;
-        let spreads = |moves: &[Vec3], (particles, distance): &Closing| {
-            particles.iter().any(|&p| free(p))
-                && closing(particles.map(|p| moves[p as usize])) >= SHARE * distance
+        let spreads = |moves: &[Vec3], pair: &Closing| {
+            pair.particles.iter().any(|&p| free(p)) && pair.spreads(previous, moves)
         };
         let mut spreading: Vec<u32> = (0..pairs.len() as u32)
             .into_par_iter()
@@ -82,7 +108,7 @@ impl SafeStep {
             self.sums.clear();
             self.sums.resize(self.moves.len(), (Vec3::ZERO, 0));
             for &k in &spreading {
-                let (particles, _) = pairs[k as usize];
+                let particles = pairs[k as usize].particles;
                 let mean = particles.iter().map(|&p| self.moves[p as usize]).sum::<Vec3>() / 4.0;
                 for p in particles.into_iter().filter(|&p| free(p)) {
                     let sum = &mut self.sums[p as usize];
@@ -110,7 +136,7 @@ impl SafeStep {
         while !spreading.is_empty() {
             let mut stopped = Vec::new();
             for &k in &spreading {
-                for p in pairs[k as usize].0.into_iter().filter(|&p| free(p)) {
+                for p in pairs[k as usize].particles.into_iter().filter(|&p| free(p)) {
                     if self.moves[p as usize] != Vec3::ZERO {
                         self.moves[p as usize] = Vec3::ZERO;
                         stopped.push(p);
@@ -132,7 +158,7 @@ impl SafeStep {
     fn index_incident(&mut self, pairs: &[Closing], particles: usize) {
         self.starts.clear();
         self.starts.resize(particles + 1, 0);
-        for &p in pairs.iter().flat_map(|(ps, _)| ps) {
+        for &p in pairs.iter().flat_map(|pair| &pair.particles) {
             self.starts[p as usize + 1] += 1;
         }
         for p in 0..particles {
@@ -141,8 +167,8 @@ impl SafeStep {
         let mut next = self.starts[..particles].to_vec();
         self.incident.clear();
         self.incident.resize(self.starts[particles] as usize, 0);
-        for (k, (ps, _)) in pairs.iter().enumerate() {
-            for &p in ps {
+        for (k, pair) in pairs.iter().enumerate() {
+            for &p in &pair.particles {
                 self.incident[next[p as usize] as usize] = k as u32;
                 next[p as usize] += 1;
             }
@@ -182,7 +208,8 @@ mod tests {
     fn a_vertex_driven_through_a_triangle_is_held_and_one_carried_with_it_is_not() {
         let previous = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.2, 0.2, 0.01]];
         let inverse_mass = [1.0; 4];
-        let pairs = [([0, 1, 2, 3], 0.01)];
+        let apart = Apart::between(Vec3::new(0.2, 0.2, 0.0), Vec3::from(previous[3]));
+        let pairs = [Closing { particles: [0, 1, 2, 3], split: 3, apart }];
         let mut step = SafeStep::default();
         let mut through = previous;
         through[3][2] = -0.02;
@@ -195,5 +222,27 @@ mod tests {
         let held = step.hold(&mut carried, &previous, &inverse_mass, &pairs, &room);
         assert_eq!(held, Held::default());
         assert_eq!(carried[3], [previous[3][0] + 0.03, 0.2, 0.01]);
+    }
+
+    /// A vertex squeezed to 0.1 mm over a triangle and pushed 1 mm away from it: its moves spread
+    /// ten times what the start distance allows, but it moves away, so it keeps its move; pushed
+    /// 1 mm through instead, it is held above.
+    #[test]
+    fn a_vertex_pushed_away_from_a_triangle_keeps_its_move() {
+        let previous = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.2, 0.2, 1e-4]];
+        let apart = Apart::between(Vec3::new(0.2, 0.2, 0.0), Vec3::from(previous[3]));
+        let pairs = [Closing { particles: [0, 1, 2, 3], split: 3, apart }];
+        let room = [Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(2.0) }; 4];
+        let mut step = SafeStep::default();
+        let mut away = previous;
+        away[3][2] = 1.1e-3;
+        let held = step.hold(&mut away, &previous, &[1.0; 4], &pairs, &room);
+        assert_eq!(held, Held::default());
+        assert_eq!(away[3], [0.2, 0.2, 1.1e-3]);
+        let mut through = previous;
+        through[3][2] = -0.9e-3;
+        step.hold(&mut through, &previous, &[1.0; 4], &pairs, &room);
+        let height = through[3][2] - (through[0][2] + through[1][2] + through[2][2]) / 3.0;
+        assert!(height > 0.0, "the vertex stays above: {through:?}");
     }
 }

@@ -9,6 +9,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::anchor::Anchor;
+use super::apart::Apart;
 use super::ends::Ends;
 use super::orientation::volume;
 use super::push::{moved, push_apart};
@@ -40,8 +41,8 @@ struct Watched {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct VertexTriangle {
     pairs: Vec<Pair>,
-    /// Each pair's distance at the start of the substep.
-    start: Vec<f32>,
+    /// How far apart each pair is at the start of the substep.
+    start: Vec<Apart>,
     watched: Vec<Watched>,
     boxes: Vec<MovingBox>,
     /// Each vertex's box.
@@ -54,21 +55,21 @@ pub(crate) struct VertexTriangle {
     vertices: BoxTree,
 }
 
-/// The distance from `vertex` to the triangle `tri` at `positions`.
-fn distance(positions: &[[f32; 3]], vertex: u32, tri: [u32; 3]) -> f32 {
+/// How far `vertex` is from the triangle `tri` at `positions`, the triangle first.
+fn apart(positions: &[[f32; 3]], vertex: u32, tri: [u32; 3]) -> Apart {
     let ([a, b, c], q) =
         (tri.map(|i| Vec3::from(positions[i as usize])), Vec3::from(positions[vertex as usize]));
-    (q - at_barycentric(closest_barycentric(q, a, b, c), a, b, c)).length()
+    Apart::between(at_barycentric(closest_barycentric(q, a, b, c), a, b, c), q)
 }
 
 /// The pair of `vertex` and `triangle` with its distance at the start of the substep `ends`, if
 /// that distance less what the moves can close is within reach.
-fn admit(ends: Ends, search: Search<[u32; 3]>, vertex: u32, triangle: u32) -> Option<(Pair, f32)> {
+fn admit(ends: Ends, search: Search<[u32; 3]>, vertex: u32, triangle: u32) -> Option<(Pair, Apart)> {
     let tri = search.elements[triangle as usize];
-    let start = distance(ends.from, vertex, tri);
-    (start - ends.closing([tri[0], tri[1], tri[2], vertex]) < search.reach.distance).then(|| {
+    let start = apart(ends.from, vertex, tri);
+    (start.distance - ends.closing([tri[0], tri[1], tri[2], vertex]) < search.reach.distance).then(|| {
         let near = search.near.touch(&[vertex], &tri);
-        let gap = search.reach.gap(near, distance(search.initial, vertex, tri));
+        let gap = search.reach.gap(near, apart(search.initial, vertex, tri).distance);
         (Pair { vertex, triangle, gap }, start)
     })
 }
@@ -109,7 +110,7 @@ impl VertexTriangle {
         self.watched = pairs
             .into_par_iter()
             .map(|(vertex, triangle)| {
-                let distance = distance(anchor.places(), vertex, faces[triangle as usize]);
+                let distance = apart(anchor.places(), vertex, faces[triangle as usize]).distance;
                 Watched { vertex, triangle, distance }
             })
             .collect();
@@ -135,7 +136,7 @@ impl VertexTriangle {
                 && w.distance - anchor.apart(&[w.vertex], &tri) - ends.closing([a, b, c, w.vertex])
                     < search.reach.distance
         };
-        let mut kept: Vec<(Pair, f32)> = self
+        let mut kept: Vec<(Pair, Apart)> = self
             .watched
             .par_iter()
             .filter(near)
@@ -150,7 +151,7 @@ impl VertexTriangle {
     /// The pairs with a particle that strayed from its path, whose boxes around the moves come
     /// within reach, that [`admit`] takes: each strayed vertex against every triangle, and each
     /// triangle with a strayed corner against every vertex that did not stray.
-    fn strays(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 3]>) -> Vec<(Pair, f32)> {
+    fn strays(&mut self, ends: Ends, anchor: &Anchor, search: Search<[u32; 3]>) -> Vec<(Pair, Apart)> {
         let faces = search.elements;
         self.boxes.clear();
         self.boxes.extend(faces.iter().map(|t| MovingBox::still(ends.swept(t))));
@@ -184,20 +185,20 @@ impl VertexTriangle {
             .collect()
     }
 
-    /// Notes each pair's distance at `positions`, the start of the substep.
+    /// Notes how far apart each pair is at `positions`, the start of the substep.
     pub fn measure(&mut self, positions: &[[f32; 3]], faces: &[[u32; 3]]) {
         self.start.clear();
         self.start.par_extend(
-            self.pairs.par_iter().map(|pair| distance(positions, pair.vertex, faces[pair.triangle as usize])),
+            self.pairs.par_iter().map(|pair| apart(positions, pair.vertex, faces[pair.triangle as usize])),
         );
     }
 
-    /// Each pair's particles, the triangle's corners then the vertex, with its distance at the
-    /// start of the substep.
+    /// Each pair's particles, the triangle's corners then the vertex, with how far apart they are
+    /// at the start of the substep.
     pub fn closing(&self, faces: &[[u32; 3]], out: &mut Vec<Closing>) {
-        out.extend(self.pairs.iter().zip(&self.start).map(|(pair, &distance)| {
+        out.extend(self.pairs.iter().zip(&self.start).map(|(pair, &apart)| {
             let [a, b, c] = faces[pair.triangle as usize];
-            ([a, b, c, pair.vertex], distance)
+            Closing { particles: [a, b, c, pair.vertex], split: 3, apart }
         }));
     }
 
@@ -213,11 +214,11 @@ impl VertexTriangle {
         faces: &[[u32; 3]],
         most: f32,
     ) {
-        for (pair, &start) in self.pairs.iter().zip(&self.start) {
+        for (pair, start) in self.pairs.iter().zip(&self.start) {
             let tri = faces[pair.triangle as usize];
             let particles = [tri[0], tri[1], tri[2], pair.vertex];
             // A pair that cannot be within its gap is skipped before the cost of its closest points.
-            if start - moved(positions, previous, &tri) - moved(positions, previous, &[pair.vertex])
+            if start.distance - moved(positions, previous, &tri) - moved(positions, previous, &[pair.vertex])
                 >= pair.gap
             {
                 continue;
