@@ -5,6 +5,9 @@
 use glam::Vec3;
 use mannequin_mesh::adjacency::face_neighbors;
 
+use crate::error::ClothError;
+use crate::layers::Layers;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Body {
     pub(crate) faces: Vec<[u32; 3]>,
@@ -13,8 +16,10 @@ pub struct Body {
     /// Faces around each vertex: `vertex_faces[vertex_starts[v]..vertex_starts[v + 1]]`.
     vertex_starts: Vec<u32>,
     vertex_faces: Vec<u32>,
-    /// The number of vertices the faces need; frames with fewer are refused.
+    /// The number of vertices the faces (and the layers) need; frames with fewer are refused.
     pub(crate) vertices_needed: usize,
+    /// Cloth worn under the simulated cloth, moving with the body.
+    layers: Option<Layers>,
 }
 
 impl Body {
@@ -36,7 +41,30 @@ impl Body {
                 next[i as usize] += 1;
             }
         }
-        Body { neighbours: face_neighbors(&faces), faces, vertex_starts, vertex_faces, vertices_needed }
+        let neighbours = face_neighbors(&faces);
+        Body { neighbours, faces, vertex_starts, vertex_faces, vertices_needed, layers: None }
+    }
+
+    /// This body worn under cloth `layers`, whose vertices follow the body's in every frame.
+    pub fn with_layers(mut self, layers: Layers) -> Result<Body, ClothError> {
+        layers.check()?;
+        self.vertices_needed = self.vertices_needed.max(layers.first_vertex + layers.rest.len());
+        self.layers = Some(layers);
+        Ok(self)
+    }
+
+    /// The body to push cloth out of, and the layers for the cloth's own contacts to hold it off:
+    /// with `self_collision`, the layers go to the contacts; else they join the body's triangles.
+    pub(crate) fn colliders(self, self_collision: bool) -> (Body, Option<Layers>) {
+        match self.layers {
+            Some(layers) if self_collision => (Body { layers: None, ..self }, Some(layers)),
+            Some(layers) => {
+                let mut faces = self.faces;
+                faces.extend(layers.faces_in_body());
+                (Body::new(faces), None)
+            }
+            None => (self, None),
+        }
     }
 
     pub fn faces(&self) -> &[[u32; 3]] {

@@ -24,6 +24,12 @@ pub enum ClothError {
          (untangle the mesh, or turn self-collision off)"
     )]
     StartsCrossed { pairs: usize, first: usize, second: usize, x: f32, y: f32, z: f32 },
+    #[error(
+        "the garment starts crossing the layers under it: {pairs} pairs of triangles intersect, the first \
+         its face {face} and their face {layer_face} near ({x:.3}, {y:.3}, {z:.3}) m; self-collision keeps \
+         apart only what starts apart (put the garment over them, or turn self-collision off)"
+    )]
+    StartsCrossingLayers { pairs: usize, face: usize, layer_face: usize, x: f32, y: f32, z: f32 },
     #[error("the simulation blew up: particle {particle} is no longer finite")]
     NonFinite { particle: usize },
 }

@@ -11,6 +11,7 @@ use crate::body::Body;
 use crate::body_contacts::BodyCollider;
 use crate::cloth::Cloth;
 use crate::error::ClothError;
+use crate::layers::Layers;
 use crate::phase_times::PhaseTimes;
 use crate::self_contacts::SelfContacts;
 use crate::settings::Settings;
@@ -28,6 +29,12 @@ pub struct Simulator {
     tethers: Tethers,
     /// Present when self-collision is on.
     contacts: Option<SelfContacts>,
+    /// Cloth under this one that the contacts hold it off (with self-collision): its particles
+    /// follow the cloth's, kinematic, moved with the body.
+    layers: Option<Layers>,
+    /// The triangles the contacts keep apart: the cloth's, then the layers'.
+    contact_faces: Vec<[u32; 3]>,
+    /// The cloth's particles, then the layers'.
     positions: Vec<[f32; 3]>,
     velocities: Vec<[f32; 3]>,
     /// Positions at the start of the current substep.
@@ -38,8 +45,9 @@ pub struct Simulator {
 }
 
 impl Simulator {
-    /// A simulator starting from the cloth's start positions at rest, colliding with `body` if given,
-    /// with `attachments` (which need a body) following it.
+    /// A simulator starting from the cloth's start positions at rest, colliding with `body` if given
+    /// (and the layers it wears, held off by the contacts with self-collision), with `attachments`
+    /// (which need a body, and refer to its own triangles) following it.
     pub fn new(
         cloth: Cloth,
         body: Option<Body>,
@@ -48,13 +56,27 @@ impl Simulator {
     ) -> Result<Self, ClothError> {
         settings.validate()?;
         let n = cloth.particle_count();
+        let (body, layers) = match body.map(|b| b.colliders(settings.self_collision)) {
+            Some((body, layers)) => (Some(body), layers),
+            None => (None, None),
+        };
         check_attachments(&attachments, n, body.as_ref())?;
         let mut inverse_mass = cloth.inverse_mass.clone();
         for a in &attachments {
             inverse_mass[a.particle as usize] = 0.0;
         }
+        let mut positions = cloth.start.clone();
+        let mut contact_faces = cloth.faces.clone();
+        let mut edges = cloth.edges();
+        if let Some(layers) = &layers {
+            let past = |e: [u32; 2]| e.map(|i| i + n as u32);
+            positions.extend_from_slice(&layers.rest);
+            contact_faces.extend(layers.faces.iter().map(|f| f.map(|i| i + n as u32)));
+            edges.extend(mannequin_mesh::adjacency::edges(&layers.faces).into_iter().map(past));
+            inverse_mass.resize(positions.len(), 0.0);
+        }
         if settings.self_collision {
-            check_uncrossed(&cloth.start, &cloth.faces)?;
+            check_uncrossed(&positions, &contact_faces, cloth.faces.len())?;
         }
         let anchors: Vec<u32> = attachments.iter().map(|a| a.particle).collect();
         let tethers = if anchors.is_empty() {
@@ -69,10 +91,12 @@ impl Simulator {
             attachments,
             contacts: settings
                 .self_collision
-                .then(|| SelfContacts::new(settings.thickness, cloth.edges(), cloth.start.clone())),
-            positions: cloth.start.clone(),
-            velocities: vec![[0.0; 3]; n],
-            previous: cloth.start.clone(),
+                .then(|| SelfContacts::new(settings.thickness, edges, positions.clone(), n as u32)),
+            layers,
+            contact_faces,
+            velocities: vec![[0.0; 3]; positions.len()],
+            previous: positions.clone(),
+            positions,
             stretch_lambda: vec![0.0; cloth.stretch.len()],
             bending_lambda: vec![0.0; cloth.bending.len()],
             cloth,
@@ -103,6 +127,17 @@ impl Simulator {
                 ));
             }
         }
+        if let Some(layers) = &self.layers {
+            // Where the caller says, moving at the frame's pace: a resumed run starts as this one.
+            let (n, first) = (self.cloth.particle_count(), layers.first_vertex);
+            let moves = body_start[first..].iter().zip(&body_end[first..]);
+            for ((x, v), (start, end)) in
+                self.positions[n..].iter_mut().zip(&mut self.velocities[n..]).zip(moves)
+            {
+                *x = *start;
+                *v = ((Vec3::from(*end) - Vec3::from(*start)) / frame_dt).to_array();
+            }
+        }
         if let Some(contacts) = &mut self.contacts {
             contacts.begin_frame();
         }
@@ -130,7 +165,7 @@ impl Simulator {
         // Before the prediction, which stills the attached particles' velocities.
         if let Some(contacts) = &mut self.contacts {
             let t = Instant::now();
-            contacts.begin_substep(&self.positions, &self.velocities, (dt, remaining), &self.cloth.faces);
+            contacts.begin_substep(&self.positions, &self.velocities, (dt, remaining), &self.contact_faces);
             self.times.hashing += t.elapsed();
         }
         let t = Instant::now();
@@ -159,16 +194,16 @@ impl Simulator {
             // Last, so the body's push does not undo them: what they leave undone the safe step holds.
             if let Some(contacts) = &self.contacts {
                 let t = Instant::now();
-                contacts.project(&mut self.positions, &self.previous, w, &self.cloth.faces);
+                contacts.project(&mut self.positions, &self.previous, w, &self.contact_faces);
                 self.times.self_contacts += t.elapsed();
             }
         }
         if let Some(contacts) = &mut self.contacts {
             let t = Instant::now();
-            contacts.find_candidates(&self.positions, &self.previous, &self.cloth.faces);
+            contacts.find_candidates(&self.positions, &self.previous, &self.contact_faces);
             self.times.hashing += t.elapsed();
             let t = Instant::now();
-            contacts.hold(&mut self.positions, &self.previous, &self.inverse_mass, &self.cloth.faces);
+            contacts.hold(&mut self.positions, &self.previous, &self.inverse_mass, &self.contact_faces);
             self.times.self_contacts += t.elapsed();
         }
         let t = Instant::now();
@@ -177,7 +212,7 @@ impl Simulator {
     }
 
     /// Eq. 3.13 before the constraints: v ← (v + Δt·g)·e^(−damping·Δt), x ← x + Δt·v; attached
-    /// particles go to their body points.
+    /// particles go to their body points, and the layers' where the body has them.
     fn predict(&mut self, dt: f32) {
         let g = Vec3::from(self.settings.gravity);
         let keep = (-self.cloth.material.damping * dt).exp();
@@ -200,6 +235,13 @@ impl Simulator {
                 let target = a.target(&body.now, &body.body.faces, &body.normals);
                 self.positions[a.particle as usize] = target.to_array();
             }
+            if let Some(layers) = &self.layers {
+                let now = &body.now[layers.first_vertex..];
+                let n = self.cloth.particle_count();
+                for (x, p) in self.positions[n..].iter_mut().zip(now) {
+                    *x = p.to_array();
+                }
+            }
         }
     }
 
@@ -210,8 +252,9 @@ impl Simulator {
         }
     }
 
+    /// The cloth's positions.
     pub fn positions(&self) -> &[[f32; 3]] {
-        &self.positions
+        &self.positions[..self.cloth.particle_count()]
     }
 
     pub fn cloth(&self) -> &Cloth {
@@ -227,27 +270,48 @@ impl Simulator {
         self.times
     }
 
+    /// The cloth's positions and velocities (the layers' come with the body's every frame).
     pub fn state(&self) -> ClothState {
-        ClothState { positions: self.positions.clone(), velocities: self.velocities.clone() }
+        let n = self.cloth.particle_count();
+        ClothState { positions: self.positions[..n].to_vec(), velocities: self.velocities[..n].to_vec() }
     }
 
     /// Continues from `state`, as saved by [`Simulator::state`] from a simulator of the same cloth.
     pub fn restore(&mut self, state: ClothState) -> Result<(), ClothError> {
-        state.check(self.positions.len())?;
-        self.positions = state.positions;
-        self.velocities = state.velocities;
+        let n = self.cloth.particle_count();
+        state.check(n)?;
+        self.positions[..n].copy_from_slice(&state.positions);
+        self.velocities[..n].copy_from_slice(&state.velocities);
         Ok(())
     }
 }
 
-/// Refuses a start where the cloth crosses itself, with the count and the place of the first
-/// crossing: the safe step would hold such a pair crossed for ever.
-fn check_uncrossed(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Result<(), ClothError> {
-    let crossed = crate::quality::self_intersections(positions, faces);
-    let Some(&[first, second]) = crossed.first() else {
-        return Ok(());
+/// Refuses a start where the cloth (the first `cloth_faces` of `faces`) crosses itself or the
+/// layers under it (the rest), with the count and the place of the first crossing: the safe step
+/// would hold such a pair crossed for ever. The layers crossing themselves are not the cloth's
+/// to mend.
+fn check_uncrossed(positions: &[[f32; 3]], faces: &[[u32; 3]], cloth_faces: usize) -> Result<(), ClothError> {
+    let crossed: Vec<[usize; 2]> = crate::quality::self_intersections(positions, faces)
+        .into_iter()
+        .filter(|&[first, _]| first < cloth_faces)
+        .collect();
+    let (itself, layers): (Vec<[usize; 2]>, _) =
+        crossed.into_iter().partition(|&[_, second]| second < cloth_faces);
+    let place = |[first, second]: [usize; 2]| {
+        let corners = faces[first].iter().chain(&faces[second]).map(|&v| Vec3::from(positions[v as usize]));
+        (corners.sum::<Vec3>() / 6.0).to_array()
     };
-    let corners = faces[first].iter().chain(&faces[second]).map(|&v| Vec3::from(positions[v as usize]));
-    let [x, y, z] = (corners.sum::<Vec3>() / 6.0).to_array();
-    Err(ClothError::StartsCrossed { pairs: crossed.len(), first, second, x, y, z })
+    if let Some(&pair) = itself.first() {
+        let [x, y, z] = place(pair);
+        let [first, second] = pair;
+        return Err(ClothError::StartsCrossed { pairs: itself.len(), first, second, x, y, z });
+    }
+    match layers.first() {
+        Some(&pair) => {
+            let [x, y, z] = place(pair);
+            let (face, layer_face) = (pair[0], pair[1] - cloth_faces);
+            Err(ClothError::StartsCrossingLayers { pairs: layers.len(), face, layer_face, x, y, z })
+        }
+        None => Ok(()),
+    }
 }

@@ -5,6 +5,7 @@
 
 use std::collections::HashSet;
 
+use mannequin_cloth::{Body, ClothError, Layers};
 use mannequin_mesh::TriMesh;
 
 /// A layer under the one being simulated: its triangles, and its positions at every frame of
@@ -16,10 +17,13 @@ pub(crate) type Layer<'a> = (&'a [[u32; 3]], &'a [Vec<[f32; 3]>]);
 /// centimetres off its skinned place, and hands swing past the hips.
 const REACH: f32 = 0.1;
 
-/// The collider's triangles over the kept body vertices followed by the inner layers' vertices.
+/// The collider's vertices: the kept body vertices followed by the inner layers'.
 pub(crate) struct Collider<'a> {
     kept: Vec<u32>,
+    /// Triangles over the kept body vertices.
     pub faces: Vec<[u32; 3]>,
+    /// The inner layers' triangles, over their own vertices.
+    layer_faces: Vec<[u32; 3]>,
     body_frames: &'a [Vec<[f32; 3]>],
     inner: &'a [Layer<'a>],
 }
@@ -50,13 +54,23 @@ impl<'a> Collider<'a> {
             (0..body_faces.len()).filter(|&f| body_faces[f].iter().any(|&v| near[v as usize])).collect();
         let body = TriMesh::new(body_frames[0].clone(), body_faces.to_vec());
         let (part, kept) = body.submesh(&kept_faces);
-        let mut faces = part.faces;
-        let mut offset = kept.len() as u32;
+        let mut layer_faces = Vec::new();
+        let mut offset = 0;
         for (f, frames) in inner {
-            faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
+            layer_faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
             offset += frames[0].len() as u32;
         }
-        Self { kept, faces, body_frames, inner }
+        Self { kept, faces: part.faces, layer_faces, body_frames, inner }
+    }
+
+    /// The body part as a collider, wearing the inner layers.
+    pub fn body(&self) -> Result<Body, ClothError> {
+        let body = Body::new(self.faces.clone());
+        if self.inner.is_empty() {
+            return Ok(body);
+        }
+        let rest = self.at(0).split_off(self.kept.len());
+        body.with_layers(Layers { first_vertex: self.kept.len(), faces: self.layer_faces.clone(), rest })
     }
 
     /// The collider's vertices at schedule frame `k`.

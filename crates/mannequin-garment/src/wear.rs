@@ -5,7 +5,7 @@
 //! each frame with what a checkpoint needs, and resumes from such a checkpoint bit for bit.
 
 use mannequin_body::Settling;
-use mannequin_cloth::{Attachment, Body, Cloth, ClothState, PhaseTimes, Settings, Simulator};
+use mannequin_cloth::{Attachment, Cloth, ClothState, PhaseTimes, Settings, Simulator};
 
 use crate::collider::{Collider, Layer};
 use crate::error::GarmentError;
@@ -172,15 +172,16 @@ fn simulate_layer<E: From<GarmentError>>(
         })
         .collect::<Result<_, GarmentError>>()?;
     let collider = Collider::new(wearer.frames, wearer.faces, inner, &skinned);
-    let faces = collider.faces.clone();
     let at_rest = collider.at(0);
+    // Held to the body itself, under the layers.
     let attachments: Vec<Attachment> = dressed
         .held()
         .into_iter()
-        .map(|v| Attachment::bind(&at_rest, &faces, v, mesh.positions[v as usize]))
+        .map(|v| Attachment::bind(&at_rest, &collider.faces, v, mesh.positions[v as usize]))
         .collect();
-    let mut sim = Simulator::new(cloth, Some(Body::new(faces)), attachments, settings)
-        .map_err(failed("at rest".into()))?;
+    let body = collider.body().map_err(failed("at rest".into()))?;
+    let mut sim =
+        Simulator::new(cloth, Some(body), attachments, settings).map_err(failed("at rest".into()))?;
     let settle = wearer.schedule.settle;
     let mut frames = match resume {
         Some(progress) => {

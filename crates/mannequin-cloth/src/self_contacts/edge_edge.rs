@@ -109,7 +109,7 @@ fn edges_apart(positions: &[[f32; 3]], e1: [u32; 2], e2: [u32; 2]) -> Apart {
 fn admit(ends: Ends, search: Search<[u32; 2]>, a: u32, b: u32) -> Option<(Pair, Apart)> {
     let (first, second) = (a.min(b), a.max(b));
     let (e1, e2) = (search.elements[first as usize], search.elements[second as usize]);
-    if e2.iter().any(|v| e1.contains(v)) {
+    if e2.iter().any(|v| e1.contains(v)) || !search.has_cloth(&[e1[0], e1[1], e2[0], e2[1]]) {
         return None;
     }
     let start = edges_apart(ends.from, e1, e2);
@@ -152,7 +152,8 @@ impl EdgeEdge {
                 let (first, second) = (a.min(b), a.max(b));
                 let (e1, e2) = (edges[first as usize], edges[second as usize]);
                 let distance = edges_apart(anchor.places(), e1, e2).distance;
-                (!e2.iter().any(|v| e1.contains(v))).then_some(Watched { first, second, distance })
+                let mine = search.has_cloth(&[e1[0], e1[1], e2[0], e2[1]]);
+                (mine && !e2.iter().any(|v| e1.contains(v))).then_some(Watched { first, second, distance })
             })
             .collect();
     }

@@ -50,11 +50,14 @@ pub(crate) struct SelfContacts {
     reach: Reach,
     anchor: Anchor,
     stale: bool,
+    /// The cloth's particles come first, then the layers' under it.
+    cloth: u32,
 }
 
 impl SelfContacts {
-    /// Contacts of thickness h = `thickness` for a cloth of `edges` starting at `start`.
-    pub fn new(thickness: f32, edges: Vec<[u32; 2]>, start: Vec<[f32; 3]>) -> Self {
+    /// Contacts of thickness h = `thickness` for a cloth of `edges` starting at `start`, whose
+    /// particles past the first `cloth` are the layers' under it.
+    pub fn new(thickness: f32, edges: Vec<[u32; 2]>, start: Vec<[f32; 3]>, cloth: u32) -> Self {
         Self {
             neighbours: Neighbours::new(&edges, start.len()),
             start,
@@ -67,6 +70,7 @@ impl SelfContacts {
             reach: Reach { distance: (1.0 + THICKNESS_SLACK) * thickness, thickness },
             anchor: Anchor::default(),
             stale: true,
+            cloth,
         }
     }
 
@@ -86,8 +90,13 @@ impl SelfContacts {
         (dt, remaining): (f32, f32),
         faces: &[[u32; 3]],
     ) {
-        let search =
-            Search { initial: &self.start, elements: faces, reach: self.reach, near: &self.neighbours };
+        let search = Search {
+            initial: &self.start,
+            elements: faces,
+            reach: self.reach,
+            near: &self.neighbours,
+            cloth: self.cloth,
+        };
         if self.stale || self.anchor.is_spent() {
             self.anchor.set(positions, velocities, remaining, dt);
             self.vertex_triangle.watch(&self.anchor, search);
@@ -123,8 +132,13 @@ impl SelfContacts {
     /// from their predicted paths.
     pub fn find_candidates(&mut self, positions: &[[f32; 3]], previous: &[[f32; 3]], faces: &[[u32; 3]]) {
         let ends = Ends { from: previous, to: positions };
-        let search =
-            Search { initial: &self.start, elements: faces, reach: self.reach, near: &self.neighbours };
+        let search = Search {
+            initial: &self.start,
+            elements: faces,
+            reach: self.reach,
+            near: &self.neighbours,
+            cloth: self.cloth,
+        };
         self.anchor.advance(ends);
         self.vertex_triangle.find(ends, &self.anchor, search);
         self.edge_edge.find(ends, &self.anchor, search.over(&self.edges));

@@ -11,11 +11,19 @@ pub(super) struct Search<'a, E> {
     pub elements: &'a [E],
     pub reach: Reach,
     pub near: &'a Neighbours,
+    /// Particles below this are the cloth's; the rest are the layers' under it, which meet only
+    /// the cloth: a pair of the layers' particles alone is none of its contacts.
+    pub cloth: u32,
 }
 
 impl<'a, E> Search<'a, E> {
     /// The same search over other elements.
     pub fn over<F>(self, elements: &'a [F]) -> Search<'a, F> {
-        Search { initial: self.initial, elements, reach: self.reach, near: self.near }
+        Search { initial: self.initial, elements, reach: self.reach, near: self.near, cloth: self.cloth }
+    }
+
+    /// Whether a pair of these particles has one of the cloth's.
+    pub fn has_cloth(&self, particles: &[u32]) -> bool {
+        particles.iter().any(|&p| p < self.cloth)
     }
 }

@@ -66,6 +66,9 @@ fn apart(positions: &[[f32; 3]], vertex: u32, tri: [u32; 3]) -> Apart {
 /// that distance less what the moves can close is within reach.
 fn admit(ends: Ends, search: Search<[u32; 3]>, vertex: u32, triangle: u32) -> Option<(Pair, Apart)> {
     let tri = search.elements[triangle as usize];
+    if !search.has_cloth(&[tri[0], tri[1], tri[2], vertex]) {
+        return None;
+    }
     let start = apart(ends.from, vertex, tri);
     (start.distance - ends.closing([tri[0], tri[1], tri[2], vertex]) < search.reach.distance).then(|| {
         let near = search.near.touch(&[vertex], &tri);
@@ -109,9 +112,14 @@ impl VertexTriangle {
         let pairs = self.meeting(initial, faces, anchor.horizon, search.reach.distance);
         self.watched = pairs
             .into_par_iter()
-            .map(|(vertex, triangle)| {
-                let distance = apart(anchor.places(), vertex, faces[triangle as usize]).distance;
-                Watched { vertex, triangle, distance }
+            .filter_map(|(vertex, triangle)| {
+                let tri = faces[triangle as usize];
+                let distance = apart(anchor.places(), vertex, tri).distance;
+                search.has_cloth(&[tri[0], tri[1], tri[2], vertex]).then_some(Watched {
+                    vertex,
+                    triangle,
+                    distance,
+                })
             })
             .collect();
     }
