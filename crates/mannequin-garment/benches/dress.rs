@@ -1,7 +1,8 @@
 //! Dressing at the size: pants under a T-shirt (size M, made on the default body) on a
 //! 4 s walk at 30 fps, against its 20 s target on a 2-core CPU. Each run's per-stage times come
 //! from its metrics.json. The baseline in the same run is the same job skinned only (Eqs.
-//! 3.2-3.3, `no_simulation`), so the ratio says what the cloth simulation costs. The pipeline is
+//! 3.2-3.3, `no_simulation`), so the ratio says what the cloth simulation costs; the job without
+//! cloth–cloth contacts (`--no-self-collision`) is timed beside it. The pipeline is
 //! timed as the library runs it: without the frames `mannequin dress` renders.
 //!
 //! `cargo bench -p mannequin-garment --bench dress [-- --seconds 4]`
@@ -74,6 +75,9 @@ fn main() {
     println!("dress: pants + T-shirt (size M) on a {seconds} s walk at 30 fps, default body");
     let skinned = time_dressing(&job, &skinning, &dir.join("skinned"));
     println!("  skinned only (baseline): {skinned:.1} s  [{}]", stages(&dir.join("skinned")));
+    let apart = DressSettings { self_collision: false, ..DressSettings::default() };
+    let crossing = time_dressing(&job, &apart, &dir.join("crossing"));
+    println!("  no self-collision:       {crossing:.1} s  [{}]", stages(&dir.join("crossing")));
     let simulated = time_dressing(&job, &DressSettings::default(), &dir.join("simulated"));
     println!("  simulated (default):     {simulated:.1} s  [{}]", stages(&dir.join("simulated")));
     println!(

@@ -23,9 +23,11 @@ pub struct DressSettings {
     /// Skin the garments only (Eqs. 3.2–3.3), without the cloth simulator.
     #[arg(long = "no-simulation")]
     pub no_simulation: bool,
-    /// Cloth–cloth contacts within each garment (vertex–triangle and edge–edge), as `cloth
-    /// simulate` has by default; off here until they also hold the layers apart.
-    #[arg(long = "self-collision")]
+    /// Turn off the cloth–cloth contacts (vertex–triangle and edge–edge), which keep every
+    /// garment from crossing itself and the layers under it; off, each layer is pushed out of
+    /// those under it as out of the body, which runs about 2.5× faster but lets the layers cross.
+    /// metrics.json counts the crossings either way.
+    #[arg(long = "no-self-collision", action = clap::ArgAction::SetFalse)]
     pub self_collision: bool,
     /// Save a checkpoint every this many simulated frames (0: never); a re-run of the same
     /// command goes on from it.
@@ -42,7 +44,7 @@ impl Default for DressSettings {
             size: "M".into(),
             stepping: Stepping::default(),
             no_simulation: false,
-            self_collision: false,
+            self_collision: true,
             checkpoint_every: 60,
             restart: false,
         }
