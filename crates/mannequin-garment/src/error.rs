@@ -14,8 +14,8 @@ pub enum GarmentError {
     File { path: String, reason: String },
     #[error(transparent)]
     Body(#[from] mannequin_body::BodyError),
-    #[error("{garment} {when}: {source}")]
-    Simulation { garment: String, when: String, source: mannequin_cloth::ClothError },
+    #[error("{garment} {when}: {error}")]
+    Simulation { garment: String, when: String, error: mannequin_cloth::ClothError },
     #[error("draping: {0}")]
     Cloth(#[from] mannequin_cloth::ClothError),
     #[error(transparent)]

@@ -4,8 +4,14 @@
 //! (rows of I^g), so the fix is a longer offset D^g over the inner garment's cover, which
 //! Eq. 3.2 then carries to every body shape.
 
+use std::collections::HashSet;
+
 use glam::Vec3;
 use mannequin_body::BodyModel;
+use mannequin_cloth::quality::self_intersections;
+use mannequin_mesh::adjacency::one_rings;
+use mannequin_mesh::closest_point::ClosestPoint;
+use mannequin_mesh::normals::{face_normals, vertex_normals};
 
 use crate::error::GarmentError;
 use crate::garment::Garment;
@@ -30,23 +36,130 @@ impl Garment {
                 }
             }
         }
+        let normals = vertex_normals(&self.mesh.positions, &self.mesh.faces);
         let offsets = self
             .binding
             .iter()
-            .zip(&self.offsets)
-            .map(|(point, d)| {
+            .zip(self.offsets.iter().zip(&normals))
+            .map(|(point, (d, normal))| {
                 let under =
                     body_faces[point.face as usize].iter().map(|&v| cover[v as usize]).fold(0.0, f32::max);
                 let d = Vec3::from(*d);
                 if under == 0.0 || d.length() >= under + gap {
                     return d.to_array();
                 }
-                (d.normalize_or_zero() * (under + gap)).to_array()
+                // Along the garment's own normal, outward, so neighbours move alike.
+                let n = Vec3::from(*normal);
+                let out = if n == Vec3::ZERO { d.normalize_or_zero() } else { n * n.dot(d).signum() };
+                (d + (under + gap - d.length()) * out).to_array()
             })
             .collect();
-        Ok(Garment { offsets, ..self.clone() })
+        let offsets = self.clear_of(inner, offsets, gap, model);
+        Ok(Garment { offsets: self.uncrossed(offsets), ..self.clone() })
+    }
+
+    /// `offsets` pushed on, along the inner garments' normals, wherever a vertex is nearer than
+    /// `gap` to their surface or behind it, on the model's template body: where an inner garment
+    /// bridges a hollow (the seat between the buttocks), its offsets from the body points around
+    /// say little of where its surface is.
+    fn clear_of(
+        &self,
+        inner: &[&Garment],
+        mut offsets: Vec<[f32; 3]>,
+        gap: f32,
+        model: &BodyModel,
+    ) -> Vec<[f32; 3]> {
+        if inner.is_empty() {
+            return offsets;
+        }
+        let body = (model.v_template.as_slice(), model.faces.as_slice());
+        let (mut positions, mut faces, mut away) = (Vec::new(), Vec::new(), Vec::new());
+        for g in inner {
+            let first = positions.len() as u32;
+            positions.extend(g.on_body(body.0, body.1));
+            faces.extend(g.mesh.faces.iter().map(|f| f.map(|i| i + first)));
+            away.extend(g.offsets.iter().map(|&d| Vec3::from(d)));
+        }
+        // Each inner face's normal, turned away from the body.
+        let normals: Vec<Vec3> = face_normals(&positions, &faces)
+            .into_iter()
+            .zip(&faces)
+            .map(|(n, f)| {
+                let n = Vec3::from(n);
+                n * n.dot(f.iter().map(|&i| away[i as usize]).sum::<Vec3>()).signum()
+            })
+            .collect();
+        let surface = ClosestPoint::new(&positions, &faces, 2.0 * gap);
+        let points: Vec<Vec3> = self.binding.iter().map(|b| b.locate(body.0, body.1)).collect();
+        for _ in 0..CLEARING_ROUNDS {
+            let mut pushed = false;
+            for (point, d) in points.iter().zip(&mut offsets) {
+                let p = *point + Vec3::from(*d);
+                let Some((on, q)) = surface.query(p) else { break };
+                let (n, apart) = (normals[on.face as usize], p - q);
+                let clearance = apart.dot(n);
+                if clearance < gap && apart.length() < CLEARING_REACH * gap {
+                    *d = (Vec3::from(*d) + (gap - clearance) * n).to_array();
+                    pushed = true;
+                }
+            }
+            if !pushed {
+                break;
+            }
+        }
+        offsets
+    }
+
+    /// `offsets` where they do not make the garment cross itself: grown where the garment
+    /// passes over a narrow place (the seat between the buttocks), two sides can be pushed past
+    /// each other, and a garment that starts crossed cannot be simulated with its contacts. The
+    /// growth of each vertex of a pair crossed anew is smoothed, the mean of its own and its
+    /// neighbours', until none is.
+    fn uncrossed(&self, mut offsets: Vec<[f32; 3]>) -> Vec<[f32; 3]> {
+        let faces = &self.mesh.faces;
+        let own = |v: usize| Vec3::from(self.offsets[v]);
+        let at = |offsets: &[[f32; 3]]| -> Vec<[f32; 3]> {
+            let moved = self.mesh.positions.iter().zip(offsets).enumerate();
+            moved.map(|(v, (p, d))| (Vec3::from(*p) + Vec3::from(*d) - own(v)).to_array()).collect()
+        };
+        let rings = one_rings(self.vertex_count(), faces);
+        let before: HashSet<[usize; 2]> =
+            self_intersections(&self.mesh.positions, faces).into_iter().collect();
+        for _ in 0..UNCROSSING_ROUNDS {
+            let crossed: HashSet<u32> = self_intersections(&at(&offsets), faces)
+                .into_iter()
+                .filter(|p| !before.contains(p))
+                .flat_map(|[f, g]| faces[f].into_iter().chain(faces[g]))
+                .collect();
+            if crossed.is_empty() {
+                break;
+            }
+            let growth = |v: usize| Vec3::from(offsets[v]) - own(v);
+            let smoothed: Vec<(usize, Vec3)> = crossed
+                .iter()
+                .map(|&v| {
+                    let ring = &rings[v as usize];
+                    let sum = ring.iter().map(|&w| growth(w as usize)).sum::<Vec3>() + growth(v as usize);
+                    (v as usize, sum / (ring.len() + 1) as f32)
+                })
+                .collect();
+            for (v, g) in smoothed {
+                offsets[v] = (own(v) + g).to_array();
+            }
+        }
+        offsets
     }
 }
+
+/// Rounds of pushing vertices clear of the inner garments: a push can bring a vertex near
+/// another part of them.
+const CLEARING_ROUNDS: usize = 4;
+/// Vertices farther than this many gaps from an inner garment are beside it, not over it.
+const CLEARING_REACH: f32 = 3.0;
+
+/// Rounds of smoothing the growth of vertices that cross: each round's may bring neighbours
+/// into a crossing.
+const UNCROSSING_ROUNDS: usize = 16;
 
 #[cfg(test)]
 mod tests {

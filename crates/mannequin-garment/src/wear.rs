@@ -160,7 +160,7 @@ fn simulate_layer<E: From<GarmentError>>(
     mesh.positions = rest.clone();
     let material = garment.recipe.material;
     let failed =
-        |when: String| move |source| GarmentError::Simulation { garment: name.to_string(), when, source };
+        |when: String| move |error| GarmentError::Simulation { garment: name.to_string(), when, error };
     let cloth = Cloth::new(&mesh, &material, &[]).map_err(failed("at rest".into()))?;
 
     // The layer skinned (Eq. 3.3) every few frames says which part of the body it can meet.

@@ -63,17 +63,15 @@ impl Wardrobe {
         let settle = Settling::settle_frames(settings.stepping.settle, motion.fps)?;
         let vertices = model.num_vertices() + loaded.iter().map(|(_, g)| g.vertex_count()).sum::<usize>();
         check_kept_positions(job.performer.motion_path, settle + motion.num_frames(), vertices)?;
-        // Each layer stands clear of those under it (in rest space, so on every body shape).
-        let templates = loaded
-            .iter()
-            .enumerate()
-            .map(|(i, (name, g))| {
-                let inner: Vec<&Garment> = loaded[..i].iter().map(|(_, g)| g).collect();
-                let layered =
-                    g.over(&inner, LAYER_GAP, model).map_err(|e| DressError::from(e).of(name.clone()))?;
-                Ok((name.clone(), layered))
-            })
-            .collect::<Result<_, DressError>>()?;
+        // Each layer stands clear of those under it as they stand (in rest space, so on every
+        // body shape).
+        let mut templates: Vec<(String, Garment)> = Vec::with_capacity(loaded.len());
+        for (name, g) in &loaded {
+            let inner: Vec<&Garment> = templates.iter().map(|(_, g)| g).collect();
+            let layered =
+                g.over(&inner, LAYER_GAP, model).map_err(|e| DressError::from(e).of(name.clone()))?;
+            templates.push((name.clone(), layered));
+        }
         Ok(Self { templates, started })
     }
 }
