@@ -55,6 +55,13 @@ fn a_made_template_reads_back() {
     let args = ["dress", "--body", "default-lod1", "--garments", s(&file), "--motion", s(&walk)];
     let o = mannequin(&[&args[..], &["--out", s(&dir.join("x"))]].concat());
     one_line_error(&o, &["tshirt.garment", "body: the garment was made on 'default' (", "make it again"]);
+    // Pants over a T-shirt (tucked in) are refused with the cloth–cloth contacts on, naming the
+    // ways out: the pants blew up.
+    let pants = dir.join("pants.garment");
+    ok(mannequin(&["garment", "make", "--category", "pants", "--out", s(&pants)]));
+    let tucked = format!("{},{}", s(&file), s(&pants));
+    let o = mannequin(&["dress", "--garments", &tucked, "--motion", s(&walk), "--out", s(&dir.join("x"))]);
+    one_line_error(&o, &["--garments: pants over tshirt", "list tshirt after pants", "--no-self-collision"]);
     // Issue 42: `--settle inf` grew to 24 GB.
     let o =
         mannequin(&["dress", "--garments", s(&file), "--motion", s(&walk), "--settle", "inf", "--out", "x"]);

@@ -90,13 +90,7 @@ impl SelfContacts {
         (dt, remaining): (f32, f32),
         faces: &[[u32; 3]],
     ) {
-        let search = Search {
-            initial: &self.start,
-            elements: faces,
-            reach: self.reach,
-            near: &self.neighbours,
-            cloth: self.cloth,
-        };
+        let search = Search::new(&self.start, faces, self.reach, &self.neighbours, self.cloth);
         if self.stale || self.anchor.is_spent() {
             self.anchor.set(positions, velocities, remaining, dt);
             self.vertex_triangle.watch(&self.anchor, search);
@@ -132,13 +126,7 @@ impl SelfContacts {
     /// from their predicted paths.
     pub fn find_candidates(&mut self, positions: &[[f32; 3]], previous: &[[f32; 3]], faces: &[[u32; 3]]) {
         let ends = Ends { from: previous, to: positions };
-        let search = Search {
-            initial: &self.start,
-            elements: faces,
-            reach: self.reach,
-            near: &self.neighbours,
-            cloth: self.cloth,
-        };
+        let search = Search::new(&self.start, faces, self.reach, &self.neighbours, self.cloth);
         self.anchor.advance(ends);
         self.vertex_triangle.find(ends, &self.anchor, search);
         self.edge_edge.find(ends, &self.anchor, search.over(&self.edges));

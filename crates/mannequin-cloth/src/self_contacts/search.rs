@@ -17,6 +17,16 @@ pub(super) struct Search<'a, E> {
 }
 
 impl<'a, E> Search<'a, E> {
+    pub fn new(
+        initial: &'a [[f32; 3]],
+        elements: &'a [E],
+        reach: Reach,
+        near: &'a Neighbours,
+        cloth: u32,
+    ) -> Self {
+        Search { initial, elements, reach, near, cloth }
+    }
+
     /// The same search over other elements.
     pub fn over<F>(self, elements: &'a [F]) -> Search<'a, F> {
         Search { initial: self.initial, elements, reach: self.reach, near: self.near, cloth: self.cloth }

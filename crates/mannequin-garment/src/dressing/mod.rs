@@ -21,6 +21,7 @@ use mannequin_cloth::{Performer, Settings};
 use mannequin_mesh::MorphSequence;
 
 use crate::dress_error::DressError;
+use crate::error::GarmentError;
 use crate::garment::Garment;
 use crate::garment_cache::load_or_make;
 use crate::layered_scene::write_layered_scene;
@@ -60,6 +61,9 @@ impl Wardrobe {
             .iter()
             .map(|g| load_or_make(g, model, job.performer.body, &settings.size))
             .collect::<Result<_, _>>()?;
+        if settings.self_collision && !settings.no_simulation {
+            refuse_tucked_in(&loaded)?;
+        }
         let settle = Settling::settle_frames(settings.stepping.settle, motion.fps)?;
         let vertices = model.num_vertices() + loaded.iter().map(|(_, g)| g.vertex_count()).sum::<usize>();
         check_kept_positions(job.performer.motion_path, settle + motion.num_frames(), vertices)?;
@@ -74,6 +78,25 @@ impl Wardrobe {
         }
         Ok(Self { templates, started })
     }
+}
+
+/// Refuses a lower-body garment over one that is not (a shirt tucked into trousers) with the
+/// cloth–cloth contacts on: its waistband, held to the body through the garment under it,
+/// meets that garment where it was simulated without the waistband, and the layers, each
+/// holding the other off, tear the outer one apart.
+fn refuse_tucked_in(loaded: &[(String, Garment)]) -> Result<(), DressError> {
+    for (i, (name, g)) in loaded.iter().enumerate() {
+        let over = loaded[..i].iter().find(|(_, under)| !under.recipe.category.is_lower_body());
+        if let (true, Some((under, _))) = (g.recipe.category.is_lower_body(), over) {
+            let reason = format!(
+                "{name} over {under}: a waistband held to the body over another garment (tucked in) \
+                 is not simulated with cloth–cloth contacts yet; list {under} after {name}, or add \
+                 --no-self-collision"
+            );
+            return Err(GarmentError::invalid("--garments", reason).into());
+        }
+    }
+    Ok(())
 }
 
 /// A dressing done: every layer's positions and the body's at every frame of the schedule
