@@ -69,10 +69,11 @@ impl Simulator {
         let mut contact_faces = cloth.faces.clone();
         let mut edges = cloth.edges();
         if let Some(layers) = &layers {
-            let past = |e: [u32; 2]| e.map(|i| i + n as u32);
+            // The layers' particles follow the cloth's.
+            let past = |i: u32| i + n as u32;
             positions.extend_from_slice(&layers.rest);
-            contact_faces.extend(layers.faces.iter().map(|f| f.map(|i| i + n as u32)));
-            edges.extend(mannequin_mesh::adjacency::edges(&layers.faces).into_iter().map(past));
+            contact_faces.extend(layers.faces.iter().map(|f| f.map(past)));
+            edges.extend(mannequin_mesh::adjacency::edges(&layers.faces).into_iter().map(|e| e.map(past)));
             inverse_mass.resize(positions.len(), 0.0);
         }
         if settings.self_collision {

@@ -2,7 +2,8 @@
 //! than the inner one wherever both cover it, or the two start inside each other and the
 //! simulator cannot tell which side each belongs on. Both hang on the same body surface points
 //! (rows of I^g), so the fix is a longer offset D^g over the inner garment's cover, which
-//! Eq. 3.2 then carries to every body shape.
+//! Eq. 3.2 then carries to every body shape; where the inner garment bridges a hollow, its own
+//! surface, not its offsets, says how much longer.
 
 use std::collections::HashSet;
 
@@ -18,9 +19,11 @@ use crate::garment::Garment;
 
 impl Garment {
     /// This garment worn over `inner` (innermost first), all on `model`: wherever an inner
-    /// garment covers the body face a vertex hangs on, its offset grows to at least that
-    /// garment's offset there plus `gap`, along the same direction. A garment made on a model of
-    /// another topology is refused.
+    /// garment covers the body face a vertex hangs on, its offset grows by what it lacks of that
+    /// garment's offset there plus `gap`, along the garment's own outward normal; then it is
+    /// pushed clear of the inner garments' surfaces ([`Garment::clear_of`]) and kept from
+    /// crossing itself ([`Garment::uncrossed`]). A garment made on a model of another topology
+    /// is refused.
     pub fn over(&self, inner: &[&Garment], gap: f32, model: &BodyModel) -> Result<Garment, GarmentError> {
         for g in inner.iter().copied().chain([self]) {
             g.check_body(model)?;
