@@ -25,7 +25,7 @@ use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 
 use super::SplatConfig;
-use super::device_buffers::{buffer, read, u32_of, units_dim, units_grid, zeros};
+use super::device_buffers::{buffer, read, u32_of, units_dim, units_grid, upload};
 use super::radix_sort::sort_pairs;
 use super::scan::exclusive_scan;
 use crate::composite::field;
@@ -192,6 +192,10 @@ fn count_tiles(
     #[comptime] cull: bool,
 ) {
     let r = ABSOLUTE_POS;
+    // The word past the last count is zero, so that the scan leaves the total there.
+    if r == n as usize {
+        counts[r] = 0u32;
+    }
     if r >= n as usize {
         terminate!();
     }
@@ -308,7 +312,8 @@ pub(super) fn bin(
     let cull = threshold > 0.0;
     let client = rows.client.clone();
     let (mut keys, mut order) = (buffer(n.max(1), rows), buffer(n.max(1), rows));
-    let counts = zeros(vec![n + 1], rows);
+    // `count_tiles` writes every word of it (one per Gaussian, then the zero past them).
+    let counts = if n > 0 { buffer(n + 1, rows) } else { upload(vec![0.0], rows) };
     if n > 0 {
         depth_keys::launch(
             &client,
@@ -325,7 +330,7 @@ pub(super) fn bin(
         (keys, order) = sort_pairs(keys, order, n, u32::BITS);
         count_tiles::launch(
             &client,
-            units_grid(n),
+            units_grid(n + 1),
             units_dim(),
             rows.clone().into_buffer_arg(),
             radii.clone().into_buffer_arg(),

@@ -14,10 +14,10 @@ use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
 use burn_cubecl::kernel::into_contiguous;
 
 use super::binning::bin;
-use super::device_buffers::{buffer, u32_of, units_dim, units_grid, upload, zeros};
-use super::kernels::{LayoutLaunch, composite_backward, composite_forward};
+use super::device_buffers::{buffer, empty, u32_of, units_dim, units_grid, upload, zeros};
+use super::kernels::{LayoutLaunch, composite_backward, composite_forward, pack_state};
 use super::project_kernels::{camera_words, project_backward, project_forward};
-use super::saved::{WordLayout, size_words};
+use super::saved::{SKIPPED, WordLayout, size_words};
 use super::{SplatBackend, SplatConfig};
 use crate::camera::CameraParams;
 use crate::composite::field;
@@ -67,10 +67,10 @@ pub(super) fn project(inputs: [CubeTensor; 5], config: &SplatConfig) -> Projecte
     let like = means.clone();
     let n = means.shape()[0];
     let stride = field::COLOR + config.channels();
-    // Rows of skipped Gaussians stay zero; every radius is written.
-    let rows = zeros(vec![n * stride], &like);
+    // `project_forward` writes every row and radius; the count starts at zero.
+    let rows = buffer(n * stride, &like);
     let radii = buffer(2 * n, &like);
-    let skipped = zeros(vec![1], &like);
+    let skipped = upload(vec![0.0], &like);
     if n > 0 {
         project_forward::launch(
             &like.client,
@@ -117,13 +117,23 @@ impl SplatBackend for CubeBackend {
         let layout = WordLayout::parse(&head).expect("sizes just written");
         // A second forward on one config would leave the first header: never, see the field.
         let _ = config.header.set(head.clone());
-        let mut parts = vec![upload(head, &like), p.skipped, tiles.offsets];
-        parts.extend(tiles.ids);
-        parts.push(p.rows);
-        let words = Self::float_cat(parts, 0);
+        let words = buffer(layout.last + w * h, &like);
+        let ids = tiles.ids.unwrap_or_else(|| tiles.offsets.clone());
+        pack_state::launch(
+            &like.client,
+            units_grid(layout.last),
+            units_dim(),
+            upload(head, &like).into_buffer_arg(),
+            p.skipped.into_buffer_arg(),
+            tiles.offsets.into_buffer_arg(),
+            ids.into_buffer_arg(),
+            p.rows.into_buffer_arg(),
+            words.clone().into_buffer_arg(),
+            launch_layout(&layout, &config),
+            u32_of(SKIPPED),
+        );
         // The compositing writes every pixel of both.
         let rendered = Self::float_empty([c + 2, h, w].into(), &like.device, FloatDType::F32);
-        let last = buffer(w * h, &like);
         composite_forward::launch(
             &like.client,
             tile_grid(&config),
@@ -131,11 +141,10 @@ impl SplatBackend for CubeBackend {
             words.clone().into_buffer_arg(),
             params(&config, &like).into_buffer_arg(),
             rendered.clone().into_buffer_arg(),
-            last.clone().into_buffer_arg(),
             launch_layout(&layout, &config),
             c,
         );
-        (rendered, Self::float_cat(vec![words, last], 0))
+        (rendered, words)
     }
 
     fn splat_backward(
@@ -152,10 +161,12 @@ impl SplatBackend for CubeBackend {
         let like = means.clone();
         let n = means.shape()[0];
         let shape = |t: &CubeTensor| t.shape().to_vec();
-        let d = [&means, &rotations, &scales, &opacities, &colors].map(|t| zeros(shape(t), &like));
+        // `project_backward` writes every word of these.
+        let d = [&means, &rotations, &scales, &opacities, &colors].map(|t| empty(shape(t), &like));
         let c = config.channels();
         let head = config.header.get().expect("splat_forward wrote the header on this config").clone();
         let layout = WordLayout::parse(&head).expect("the state splat_forward saved");
+        // Pixels add into these.
         let sums = zeros(vec![n.max(1) * (SCREEN_GRADS + c)], &like);
         composite_backward::launch(
             &like.client,

@@ -28,9 +28,14 @@ pub(super) fn zeros(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
     CubeBackend::float_zeros(shape.into(), &like.device(), FloatDType::F32)
 }
 
+/// An uninitialised `f32` buffer of `shape` that a kernel fills whole.
+pub(super) fn empty(shape: Vec<usize>, like: &CubeTensor) -> CubeTensor {
+    CubeBackend::float_empty(shape.into(), &like.device(), FloatDType::F32)
+}
+
 /// A buffer of `len` 32-bit words that a kernel fills (kernels read `f32` buffers as `u32` too).
 pub(super) fn buffer(len: usize, like: &CubeTensor) -> CubeTensor {
-    CubeBackend::float_empty(vec![len].into(), &like.device(), FloatDType::F32)
+    empty(vec![len], like)
 }
 
 pub(super) fn u32_of(v: usize) -> u32 {

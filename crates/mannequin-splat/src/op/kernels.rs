@@ -36,13 +36,47 @@ pub(crate) struct Layout {
     pub last: u32,
 }
 
+/// Gathers the state's parts into `words` up to the replay lengths, one unit a word: the sizes
+/// (`SKIPPED` words), the skipped count, the tile offsets, the tile lists and the packed rows.
+/// One launch where a concatenation took one a part.
+#[cube(launch)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn pack_state(
+    sizes: &[f32],
+    skipped: &[f32],
+    offsets: &[f32],
+    ids: &[f32],
+    rows: &[f32],
+    words: &mut [f32],
+    layout: Layout,
+    #[comptime] skipped_at: u32,
+) {
+    let i = ABSOLUTE_POS as u32;
+    if i >= layout.last {
+        terminate!();
+    }
+    let mut w = 0.0f32;
+    if i < skipped_at {
+        w = sizes[i as usize];
+    } else if i < layout.offsets {
+        w = skipped[0];
+    } else if i < layout.ids {
+        w = offsets[(i - layout.offsets) as usize];
+    } else if i < layout.rows {
+        w = ids[(i - layout.ids) as usize];
+    } else {
+        w = rows[(i - layout.rows) as usize];
+    }
+    words[i as usize] = w;
+}
+
 /// `params`: alpha threshold, alpha cap, transmittance floor, then the background (C values).
+/// Each pixel's replay length goes into `words` from `layout.last` on.
 #[cube(launch)]
 pub(crate) fn composite_forward(
-    words: &[f32],
+    words: &mut [f32],
     params: &[f32],
     rendered: &mut [f32],
-    last_out: &mut [f32],
     layout: Layout,
     #[comptime] channels: usize,
 ) {
@@ -100,7 +134,7 @@ pub(crate) fn composite_forward(
         let a = 1.0 - t;
         rendered[channels * npx + p] = a;
         rendered[(channels + 1) * npx + p] = depth / f32::max(a, 1e-10);
-        last_out[p] = f32::reinterpret(last);
+        words[layout.last as usize + p] = f32::reinterpret(last);
     }
 }
 

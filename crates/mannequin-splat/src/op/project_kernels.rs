@@ -246,6 +246,12 @@ pub(crate) fn project_forward(
     }
     radii[2 * i] = 0.0f32;
     radii[2 * i + 1] = 0.0f32;
+    // The buffers come uninitialised (no fill launches): rows of Gaussians left out stay zero.
+    let row = i * stride;
+    #[unroll]
+    for k in 0..stride {
+        rows[row + k] = 0.0f32;
+    }
     let rot_len = comptime!(if matrices { 9usize } else { 4usize });
     let finite = all_finite(means, 3 * i, 3)
         && all_finite(rots, rot_len * i, rot_len)
@@ -277,7 +283,6 @@ pub(crate) fn project_forward(
     if !(mx + rx > 0.0f32 && mx - rx < cam[WIDTH] && my + ry > 0.0f32 && my - ry < cam[HEIGHT]) {
         terminate!();
     }
-    let row = i * stride;
     rows[row] = mx;
     rows[row + 1] = my;
     rows[row + 2] = r / det;
@@ -339,6 +344,21 @@ pub(crate) fn project_backward(
     }
     let slots = comptime!(7 + if sh { 3usize } else { color_len });
     let g = i * slots;
+    // Every output word is written (the buffers come uninitialised: no fill launches); those of
+    // a Gaussian that is not drawn, or that no pixel's gradient reaches, stay zero.
+    let rot_len = comptime!(if matrices { 9usize } else { 4usize });
+    #[unroll]
+    for k in 0..3usize {
+        d_means[3 * i + k] = 0.0f32;
+        d_scales[3 * i + k] = 0.0f32;
+    }
+    #[unroll]
+    for k in 0..rot_len {
+        d_rots[rot_len * i + k] = 0.0f32;
+    }
+    for k in 0..color_len {
+        d_colors[color_len * i + k] = 0.0f32;
+    }
     d_opacities[i] = sums[g + 5];
     let mut nonzero = false;
     for k in 0..slots {
