@@ -89,6 +89,8 @@ pub struct Posed {
 /// [6, H, W] image (the losses read both at once), alpha and expected depth [H, W].
 #[derive(Clone, Debug)]
 pub struct Rendered {
+    /// The four as the renderer stacks them, [8, H, W]: the fused image loss reads them in place.
+    pub planes: Tensor<3>,
     pub image: Tensor<3>,
     pub alpha: Tensor<2>,
     pub depth: Tensor<2>,
@@ -386,7 +388,7 @@ impl Avatar {
             camera,
             &options,
         )?;
-        Ok(Rendered { image: out.image, alpha: out.alpha, depth: out.depth })
+        Ok(Rendered { planes: out.planes, image: out.image, alpha: out.alpha, depth: out.depth })
     }
 
     /// Writes the model directory `dir`. `avatar.npz` holds everything [`Avatar::load`] reads,

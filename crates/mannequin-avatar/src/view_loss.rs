@@ -21,22 +21,24 @@ pub fn view_loss(r: &Rendered, view: &View, o: &TrainOptions) -> Result<(Tensor<
     let target: Tensor<3> =
         Tensor::from_data(TensorData::new(view.targets.clone(), [channels, h, w]), &device);
     // Eq. 12 on colour and Eq. 13 on normals in one pass over the stacked image.
-    let (pred, weights) = if view.has_normals() {
-        let w = [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]);
-        (r.image.clone(), w.collect())
+    let weights: Vec<f64> = if view.has_normals() {
+        [1.0 / 3.0; 3].into_iter().chain([o.lambda_normal / 3.0; 3]).collect()
     } else {
-        (r.rgb(), vec![1.0 / 3.0; 3])
+        vec![1.0 / 3.0; 3]
     };
-    let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
     let mask: Tensor<2> = Tensor::from_data(TensorData::new(view.mask.clone(), [h, w]), &device);
     if host_ops::on_cube(&device) {
         let config = ImageLossConfig {
             weights: weights.iter().map(|&x| x as f32).collect(),
             lambda_ssim: o.lambda_ssim as f32,
             lambda_mask: o.lambda_mask as f32,
+            alpha_plane: r.image.dims()[0],
         };
-        return Ok((image_loss(pred, r.alpha.clone(), target, mask, &config)?, mse));
+        let out = image_loss(r.planes.clone(), target, mask, &config)?;
+        return Ok((out.loss, out.colour_mse));
     }
+    let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
+    let pred = if view.has_normals() { r.image.clone() } else { r.rgb() };
     let loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
     Ok((loss + (r.alpha.clone() - mask).abs().mean() * o.lambda_mask, mse))
 }

@@ -55,18 +55,17 @@ pub(crate) fn pack_state(
     if i >= layout.last {
         terminate!();
     }
-    let mut w = 0.0f32;
-    if i < skipped_at {
-        w = sizes[i as usize];
+    let w = if i < skipped_at {
+        sizes[i as usize]
     } else if i < layout.offsets {
-        w = skipped[0];
+        skipped[0]
     } else if i < layout.ids {
-        w = offsets[(i - layout.offsets) as usize];
+        offsets[(i - layout.offsets) as usize]
     } else if i < layout.rows {
-        w = ids[(i - layout.ids) as usize];
+        ids[(i - layout.ids) as usize]
     } else {
-        w = rows[(i - layout.rows) as usize];
-    }
+        rows[(i - layout.rows) as usize]
+    };
     words[i as usize] = w;
 }
 

@@ -59,8 +59,11 @@ pub enum ColorTensor {
     Features(Tensor<2>),
 }
 
-/// What [`splat_render`] returns; the three images are differentiable.
+/// What [`splat_render`] returns; the images are differentiable.
 pub struct SplatImages {
+    /// `[C + 2, H, W]`: the next three stacked, as the op renders them. A loss that reads them
+    /// in place spares the device the slices (copies, where a plane is not aligned).
+    pub planes: Tensor<3>,
     /// `[C, H, W]` colour or features over the background.
     pub image: Tensor<3>,
     /// `[H, W]` accumulated opacity.
@@ -191,6 +194,7 @@ pub fn splat_render(
     );
     let rendered = Tensor::<3>::from_dispatch(rendered);
     Ok(SplatImages {
+        planes: rendered.clone(),
         image: rendered.clone().narrow(0, 0, ch),
         alpha: rendered.clone().narrow(0, ch, 1).reshape([h, w]),
         depth: rendered.narrow(0, ch + 1, 1).reshape([h, w]),

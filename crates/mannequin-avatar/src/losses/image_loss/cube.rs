@@ -6,7 +6,9 @@ use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
 use burn::tensor::TensorData;
 
-use super::kernels::{loss_shares, map_gradient, pixel_gradients};
+use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
+
+use super::kernels::{SUM_UNITS, loss_shares, map_gradient, pixel_gradients, sum_shares};
 use super::{ImageLossBackend, ImageLossConfig};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::SsimBackend;
@@ -19,62 +21,72 @@ fn weights(config: &ImageLossConfig, like: &CubeTensor) -> CubeTensor {
     B::float_from_data(TensorData::new(config.weights.clone(), [n]), &like.device)
 }
 
-fn dims(pred: &CubeTensor) -> [usize; 3] {
-    pred.shape().to_vec().try_into().expect("image loss inputs are [C, H, W]")
+fn dims(t: &CubeTensor) -> [usize; 3] {
+    t.shape().to_vec().try_into().expect("image loss images are [C, H, W]")
 }
 
 impl ImageLossBackend for CubeBackend {
     fn image_loss_forward(
-        pred: FloatTensor<Self>,
-        alpha: FloatTensor<Self>,
+        rendered: FloatTensor<Self>,
         target: FloatTensor<Self>,
         mask: FloatTensor<Self>,
         config: ImageLossConfig,
-    ) -> (FloatTensor<Self>, FloatTensor<Self>) {
-        let [c, h, w] = dims(&pred);
-        let (pred, back) = as_f32(pred);
-        let [alpha, target, mask] = [alpha, target, mask].map(|t| as_f32(t).0);
-        let (map, moments) = <B as SsimBackend>::ssim_forward(pred.clone(), target.clone());
-        let share = empty_f32(vec![h * w], &pred);
-        let (count, dim) = per_element(&pred, h * w);
+    ) -> (FloatTensor<Self>, FloatTensor<Self>, FloatTensor<Self>) {
+        let [c, h, w] = dims(&target);
+        let (rendered, back) = as_f32(rendered);
+        let [target, mask] = [target, mask].map(|t| as_f32(t).0);
+        // The SSIM compares the target's C channels with the first C planes.
+        let (map, moments) = <B as SsimBackend>::ssim_forward(rendered.clone(), target.clone());
+        let share = empty_f32(vec![2, h * w], &rendered);
+        let (count, dim) = per_element(&rendered, h * w);
         loss_shares::launch(
-            &pred.client,
+            &rendered.client,
             count,
             dim,
-            pred.clone().into_buffer_arg(),
+            rendered.clone().into_buffer_arg(),
             target.into_buffer_arg(),
-            alpha.into_buffer_arg(),
             mask.into_buffer_arg(),
             as_f32(map).0.into_buffer_arg(),
-            weights(&config, &pred).into_buffer_arg(),
+            weights(&config, &rendered).into_buffer_arg(),
             share.clone().into_buffer_arg(),
             u32_of(c),
             u32_of(h),
             u32_of(w),
+            u32_of(config.alpha_plane),
             config.lambda_ssim,
             config.lambda_mask,
         );
-        (back(B::float_sum(share)), moments)
+        let (loss, mse) = (empty_f32(vec![1], &rendered), empty_f32(vec![1], &rendered));
+        sum_shares::launch(
+            &rendered.client,
+            CubeCount::Static(1, 1, 1),
+            CubeDim::new_1d(SUM_UNITS),
+            share.into_buffer_arg(),
+            loss.clone().into_buffer_arg(),
+            mse.clone().into_buffer_arg(),
+            u32_of(h * w),
+        );
+        (back(loss), back(mse), moments)
     }
 
     fn image_loss_backward(
-        pred: FloatTensor<Self>,
-        alpha: FloatTensor<Self>,
+        rendered: FloatTensor<Self>,
         target: FloatTensor<Self>,
         mask: FloatTensor<Self>,
         moments: FloatTensor<Self>,
         grad: FloatTensor<Self>,
         config: ImageLossConfig,
-    ) -> (FloatTensor<Self>, FloatTensor<Self>) {
-        let [c, h, w] = dims(&pred);
-        let (pred, back) = as_f32(pred);
-        let [alpha, target, mask, grad] = [alpha, target, mask, grad].map(|t| as_f32(t).0);
-        let weights = weights(&config, &pred);
+    ) -> FloatTensor<Self> {
+        let [c, h, w] = dims(&target);
+        let k = dims(&rendered)[0];
+        let (rendered, back) = as_f32(rendered);
+        let [target, mask, grad] = [target, mask, grad].map(|t| as_f32(t).0);
+        let weights = weights(&config, &rendered);
         let (mh, mw) = (h + 1 - TAPS, w + 1 - TAPS);
-        let d_map = empty_f32(vec![c, mh, mw], &pred);
-        let (count, dim) = per_element(&pred, c * mh * mw);
+        let d_map = empty_f32(vec![c, mh, mw], &rendered);
+        let (count, dim) = per_element(&rendered, c * mh * mw);
         map_gradient::launch(
-            &pred.client,
+            &rendered.client,
             count,
             dim,
             grad.clone().into_buffer_arg(),
@@ -86,29 +98,29 @@ impl ImageLossBackend for CubeBackend {
             config.lambda_ssim,
         );
         let (d_ssim, _) =
-            <B as SsimBackend>::ssim_backward(pred.clone(), target.clone(), moments, d_map, true, false);
-        let (d_pred, d_alpha) = (empty_f32(vec![c, h, w], &pred), empty_f32(vec![h, w], &pred));
-        let (count, dim) = per_element(&pred, h * w);
-        let client = pred.client.clone();
+            <B as SsimBackend>::ssim_backward(rendered.clone(), target.clone(), moments, d_map, true, false);
+        let d_rendered = empty_f32(vec![k, h, w], &rendered);
+        let (count, dim) = per_element(&rendered, h * w);
+        let client = rendered.client.clone();
         pixel_gradients::launch(
             &client,
             count,
             dim,
-            pred.into_buffer_arg(),
+            rendered.into_buffer_arg(),
             target.into_buffer_arg(),
-            alpha.into_buffer_arg(),
             mask.into_buffer_arg(),
             as_f32(d_ssim).0.into_buffer_arg(),
             grad.into_buffer_arg(),
             weights.into_buffer_arg(),
-            d_pred.clone().into_buffer_arg(),
-            d_alpha.clone().into_buffer_arg(),
+            d_rendered.clone().into_buffer_arg(),
             u32_of(c),
+            u32_of(k),
             u32_of(h),
             u32_of(w),
+            u32_of(config.alpha_plane),
             config.lambda_ssim,
             config.lambda_mask,
         );
-        (back(d_pred), back(d_alpha))
+        back(d_rendered)
     }
 }

@@ -1,6 +1,7 @@
 //! CubeCL kernels of the image loss, one unit per pixel: the forward writes each pixel's share
-//! of the loss (summed by one reduction after), the backward adds the L1 and mask terms' signs
-//! to the SSIM's gradient. `sign(0) = 0`, as Burn's |x| differentiates.
+//! of the loss and of the colour MSE, summed after by one cube; the backward adds the L1 and mask
+//! terms' signs to the SSIM's gradient and writes every rendered plane's gradient. `sign(0) = 0`,
+//! as Burn's |x| differentiates.
 
 // Kernels index their buffers: iterator forms do not exist in CubeCL.
 #![allow(clippy::needless_range_loop)]
@@ -20,14 +21,22 @@ fn sign(x: f32) -> f32 {
     s
 }
 
+/// Units of the cube that sums the shares.
+pub(crate) const SUM_UNITS: u32 = 256;
+
+/// The most pixels the sums take: each unit of the one cube walks `H·W/SUM_UNITS` of them, and
+/// lavapipe stops loops after 65,535 iterations.
+pub(crate) const MAX_PIXELS: usize = SUM_UNITS as usize * 65_535;
+
 /// `share[i] = Σ_c w_c·[(1 − λ)|p − t|/(HW) + λ(1 − S_c)/(H'W')] + λ_m|a − m|/(HW)`, the SSIM
-/// part only where pixel `i` anchors a map entry (`map` is `[C, H − 10, W − 10]`).
+/// part only where pixel `i` anchors a map entry (`map` is `[C, H − 10, W − 10]`), and
+/// `share[HW + i] = Σ_{c<3} (p − t)²/(3HW)`. `p` is plane c of `rendered`, `a` its plane
+/// `alpha_plane`.
 #[cube(launch)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn loss_shares(
-    pred: &[f32],
+    rendered: &[f32],
     target: &[f32],
-    alpha: &[f32],
     mask: &[f32],
     map: &[f32],
     weights: &[f32],
@@ -35,6 +44,7 @@ pub(crate) fn loss_shares(
     channels: u32,
     height: u32,
     width: u32,
+    alpha_plane: u32,
     lambda: f32,
     lambda_mask: f32,
 ) {
@@ -49,16 +59,52 @@ pub(crate) fn loss_shares(
     let valid = y < mh && x < mw;
     let inv = 1.0 / f32::cast_from(plane);
     let inv_map = 1.0 / f32::cast_from(mh * mw);
-    let mut acc = lambda_mask * f32::abs(alpha[i] - mask[i]) * inv;
+    let mut acc = lambda_mask * f32::abs(rendered[alpha_plane as usize * plane + i] - mask[i]) * inv;
+    let mut squares = 0.0f32;
     for c in 0..channels as usize {
         let k = c * plane + i;
-        let mut term = (1.0 - lambda) * f32::abs(pred[k] - target[k]) * inv;
+        let d = rendered[k] - target[k];
+        let mut term = (1.0 - lambda) * f32::abs(d) * inv;
         if valid {
             term += lambda * (1.0 - map[c * mh * mw + y * mw + x]) * inv_map;
         }
         acc += weights[c] * term;
+        if c < 3 {
+            squares += d * d;
+        }
     }
     share[i] = acc;
+    share[plane + i] = squares * inv / 3.0;
+}
+
+/// `loss[0] = Σ share[..len]` and `mse[0] = Σ share[len..2·len]`, by one cube: each unit sums
+/// every `SUM_UNITS`-th share, then unit 0 adds the units' sums. One launch, where Burn's sum
+/// takes two (a fill and an atomic reduction) per total.
+#[cube(launch)]
+pub(crate) fn sum_shares(share: &[f32], loss: &mut [f32], mse: &mut [f32], len: u32) {
+    let u = UNIT_POS_X;
+    let mut parts = Shared::<[f32]>::new_slice(2 * SUM_UNITS as usize);
+    let mut a = 0.0f32;
+    let mut b = 0.0f32;
+    let mut k = u;
+    while k < len {
+        a += share[k as usize];
+        b += share[(len + k) as usize];
+        k += SUM_UNITS;
+    }
+    parts[u as usize] = a;
+    parts[(SUM_UNITS + u) as usize] = b;
+    sync_cube();
+    if u == 0 {
+        let mut ta = 0.0f32;
+        let mut tb = 0.0f32;
+        for r in 0..SUM_UNITS {
+            ta += parts[r as usize];
+            tb += parts[(SUM_UNITS + r) as usize];
+        }
+        loss[0] = ta;
+        mse[0] = tb;
+    }
 }
 
 /// The SSIM map's gradient: `−g·λ·w_c/(H'W')` everywhere in channel c.
@@ -81,22 +127,23 @@ pub(crate) fn map_gradient(
     d_map[i] = -grad[0] * lambda * weights[i / entries] / f32::cast_from(entries);
 }
 
-/// `d_pred = d_ssim + g·(1 − λ)·w_c·sign(p − t)/(HW)`, `d_alpha = g·λ_m·sign(a − m)/(HW)`.
+/// The rendered planes' gradient `[K, H, W]`: `d_ssim + g·(1 − λ)·w_c·sign(p − t)/(HW)` on the
+/// C compared planes, `g·λ_m·sign(a − m)/(HW)` on the alpha plane, zero on the others.
 #[cube(launch)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn pixel_gradients(
-    pred: &[f32],
+    rendered: &[f32],
     target: &[f32],
-    alpha: &[f32],
     mask: &[f32],
     d_ssim: &[f32],
     grad: &[f32],
     weights: &[f32],
-    d_pred: &mut [f32],
-    d_alpha: &mut [f32],
+    d_rendered: &mut [f32],
     channels: u32,
+    planes: u32,
     height: u32,
     width: u32,
+    alpha_plane: u32,
     lambda: f32,
     lambda_mask: f32,
 ) {
@@ -106,9 +153,14 @@ pub(crate) fn pixel_gradients(
         terminate!();
     }
     let g = grad[0] / f32::cast_from(plane);
-    d_alpha[i] = g * lambda_mask * sign(alpha[i] - mask[i]);
-    for c in 0..channels as usize {
+    for c in 0..planes as usize {
         let k = c * plane + i;
-        d_pred[k] = d_ssim[k] + g * (1.0 - lambda) * weights[c] * sign(pred[k] - target[k]);
+        let mut d = 0.0f32;
+        if c < channels as usize {
+            d = d_ssim[k] + g * (1.0 - lambda) * weights[c] * sign(rendered[k] - target[k]);
+        } else if c == alpha_plane as usize {
+            d = g * lambda_mask * sign(rendered[k] - mask[i]);
+        }
+        d_rendered[k] = d;
     }
 }

@@ -1,6 +1,9 @@
 //! The fused SSIM on the CubeCL backends: the moments through the blur kernel, the per-pixel
 //! parts through the kernels of `kernels.rs`. Works in f32 (the saved moments stay f32); other
 //! float types are converted on the way in and out. Both gradients are always computed.
+//!
+//! The sizes are `y`'s `[C, H, W]`: `x` may hold more planes after its first C (the image loss
+//! passes the renderer's stacked planes, compared in place), and `x`'s gradient is `[C, H, W]`.
 
 use burn::backend::TensorMetadata;
 use burn::backend::ops::FloatTensorOps;
@@ -17,7 +20,7 @@ type B = CubeBackend;
 
 impl SsimBackend for CubeBackend {
     fn ssim_forward(x: FloatTensor<Self>, y: FloatTensor<Self>) -> (FloatTensor<Self>, FloatTensor<Self>) {
-        let [c, h, w]: [usize; 3] = x.shape().to_vec().try_into().expect("SSIM inputs are [C, H, W]");
+        let [c, h, w]: [usize; 3] = y.shape().to_vec().try_into().expect("SSIM inputs are [C, H, W]");
         let (x, back) = as_f32(x);
         let (y, _) = as_f32(y);
         let size = c * h * w;
@@ -58,7 +61,7 @@ impl SsimBackend for CubeBackend {
         _want_x: bool,
         _want_y: bool,
     ) -> (FloatTensor<Self>, FloatTensor<Self>) {
-        let [c, h, w]: [usize; 3] = x.shape().to_vec().try_into().expect("SSIM inputs are [C, H, W]");
+        let [c, h, w]: [usize; 3] = y.shape().to_vec().try_into().expect("SSIM inputs are [C, H, W]");
         let (x, back) = as_f32(x);
         let (y, _) = as_f32(y);
         let (grad, _) = as_f32(grad);
