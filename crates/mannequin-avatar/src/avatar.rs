@@ -85,26 +85,46 @@ pub struct Posed {
     pub gaussians: GaussianGeometry,
 }
 
-/// Rendered maps: colour over white and camera-space normals over zero, stacked as one
-/// [6, H, W] image (the losses read both at once), alpha and expected depth [H, W].
+/// Rendered maps as the renderer stacks them, [8, H, W]: colour over white, camera-space
+/// normals over zero, alpha and expected depth. The fused image loss reads them in place; the
+/// accessors slice them (lazily on the CPU, copies on a GPU where a plane is not aligned).
 #[derive(Clone, Debug)]
 pub struct Rendered {
-    /// The four as the renderer stacks them, [8, H, W]: the fused image loss reads them in place.
     pub planes: Tensor<3>,
-    pub image: Tensor<3>,
-    pub alpha: Tensor<2>,
-    pub depth: Tensor<2>,
 }
 
+/// Where alpha is in [`Rendered::planes`]: after the three colour and three normal planes.
+pub const ALPHA_PLANE: usize = 6;
+
 impl Rendered {
+    fn plane(&self, k: usize) -> Tensor<2> {
+        let [_, h, w] = self.planes.dims();
+        self.planes.clone().narrow(0, k, 1).reshape([h, w])
+    }
+
+    /// Colour and normals [6, H, W] (the losses read both at once).
+    pub fn image(&self) -> Tensor<3> {
+        self.planes.clone().narrow(0, 0, ALPHA_PLANE)
+    }
+
     /// Colour over white [3, H, W].
     pub fn rgb(&self) -> Tensor<3> {
-        self.image.clone().narrow(0, 0, 3)
+        self.planes.clone().narrow(0, 0, 3)
     }
 
     /// Camera-space normals over zero [3, H, W].
     pub fn normals(&self) -> Tensor<3> {
-        self.image.clone().narrow(0, 3, 3)
+        self.planes.clone().narrow(0, 3, 3)
+    }
+
+    /// Accumulated opacity [H, W].
+    pub fn alpha(&self) -> Tensor<2> {
+        self.plane(ALPHA_PLANE)
+    }
+
+    /// Expected camera-space depth [H, W].
+    pub fn depth(&self) -> Tensor<2> {
+        self.plane(ALPHA_PLANE + 1)
     }
 }
 
@@ -388,7 +408,7 @@ impl Avatar {
             camera,
             &options,
         )?;
-        Ok(Rendered { planes: out.planes, image: out.image, alpha: out.alpha, depth: out.depth })
+        Ok(Rendered { planes: out.planes })
     }
 
     /// Writes the model directory `dir`. `avatar.npz` holds everything [`Avatar::load`] reads,

@@ -25,7 +25,7 @@ pub fn observed_colours(avatar: &Avatar, views: &[View]) -> Result<Vec<Option<[f
     for view in views.iter().step_by(step) {
         let posed = avatar.pose(&view.pose, view.transl)?;
         let rendered = avatar.render(&posed, &view.camera)?;
-        let (alpha, depth) = (host(rendered.alpha), host(rendered.depth));
+        let (alpha, depth) = (host(rendered.alpha()), host(rendered.depth()));
         let means = host(posed.gaussians.means);
         let normals = host(posed.gaussians.normals);
         let cam = &view.camera;

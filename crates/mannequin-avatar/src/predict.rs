@@ -38,8 +38,8 @@ pub fn predict(
     let n = w * h;
     let rgb = host(r.rgb());
     let nrm = host(r.normals());
-    let alpha = host(r.alpha);
-    let depth = host(r.depth);
+    let alpha = host(r.alpha());
+    let depth = host(r.depth());
     let fg: Vec<bool> = alpha.iter().map(|&a| a >= FOREGROUND_ALPHA).collect();
     let image =
         Image { width: w, height: h, pixels: (0..n).map(|p| [rgb[p], rgb[n + p], rgb[2 * n + p]]).collect() };

@@ -315,7 +315,7 @@ impl Trainer {
         let mut total = Duration::ZERO;
         for _ in 0..repeats.max(1) {
             let r = self.avatar.render(&posed, &view.crop_camera())?;
-            let loss = r.image.sum() + r.alpha.sum();
+            let loss = r.image().sum() + r.alpha().sum();
             let clock = Instant::now();
             let _ = loss.backward();
             total += clock.elapsed();

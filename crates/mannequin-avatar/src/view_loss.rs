@@ -5,7 +5,7 @@
 
 use burn::tensor::{Tensor, TensorData};
 
-use crate::avatar::Rendered;
+use crate::avatar::{ALPHA_PLANE, Rendered};
 use crate::error::AvatarError;
 use crate::host_ops;
 use crate::losses::image_loss::{ImageLossConfig, image_loss};
@@ -16,7 +16,7 @@ use crate::views::View;
 /// The loss of `r` against `view`'s targets, and the colour MSE (detached, for PSNR).
 pub fn view_loss(r: &Rendered, view: &View, o: &TrainOptions) -> Result<(Tensor<1>, Tensor<1>), AvatarError> {
     let crop = &view.crop;
-    let device = r.image.device();
+    let device = r.planes.device();
     let (channels, h, w) = (view.target_channels(), crop.height, crop.width);
     let target: Tensor<3> =
         Tensor::from_data(TensorData::new(view.targets.clone(), [channels, h, w]), &device);
@@ -32,13 +32,13 @@ pub fn view_loss(r: &Rendered, view: &View, o: &TrainOptions) -> Result<(Tensor<
             weights: weights.iter().map(|&x| x as f32).collect(),
             lambda_ssim: o.lambda_ssim as f32,
             lambda_mask: o.lambda_mask as f32,
-            alpha_plane: r.image.dims()[0],
+            alpha_plane: ALPHA_PLANE,
         };
         let out = image_loss(r.planes.clone(), target, mask, &config)?;
         return Ok((out.loss, out.colour_mse));
     }
     let mse = (r.rgb().detach() - target.clone().narrow(0, 0, 3)).square().mean();
-    let pred = if view.has_normals() { r.image.clone() } else { r.rgb() };
+    let pred = if view.has_normals() { r.image() } else { r.rgb() };
     let loss = photometric_weighted(pred, target, o.lambda_ssim, &weights)?;
-    Ok((loss + (r.alpha.clone() - mask).abs().mean() * o.lambda_mask, mse))
+    Ok((loss + (r.alpha() - mask).abs().mean() * o.lambda_mask, mse))
 }

@@ -34,8 +34,7 @@ fn run(
     [c, h, w]: [usize; 3],
     loss: impl Fn(Tensor<3>, Tensor<3>, Tensor<2>) -> (Tensor<1>, Tensor<1>),
 ) -> [Vec<f32>; 3] {
-    let image =
-        |k, seed| Tensor::<3>::from_data(TensorData::new(random(k * h * w, seed), [k, h, w]), device);
+    let image = |k, seed| Tensor::<3>::from_data(TensorData::new(random(k * h * w, seed), [k, h, w]), device);
     let rendered = image(PLANES, 1).require_grad();
     let mask = Tensor::<2>::from_data(TensorData::new(random(h * w, 4), [h, w]), device);
     let (value, mse) = loss(rendered.clone(), image(c, 3), mask);
@@ -73,7 +72,9 @@ fn the_fused_image_loss_matches_its_composition() {
             let out = image_loss(rendered, target, mask, &c).expect("loss");
             (out.loss, out.colour_mse)
         });
-        for (name, (want, got)) in ["loss", "colour MSE", "d rendered"].iter().zip(composed.iter().zip(&fused)) {
+        for (name, (want, got)) in
+            ["loss", "colour MSE", "d rendered"].iter().zip(composed.iter().zip(&fused))
+        {
             let scale = want.iter().fold(0f32, |m, w| m.max(w.abs()));
             let worst = want.iter().zip(got).map(|(w, g)| (w - g).abs()).fold(0f32, f32::max);
             // f32 sums over a few thousand pixels in another order.

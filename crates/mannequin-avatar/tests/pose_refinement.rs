@@ -32,7 +32,7 @@ fn fitting_a_pose_to_an_image_of_the_avatar_undoes_a_perturbation() {
     let true_transl = [0.0, 0.0, 0.0];
     let posed = avatar.pose(&truth, true_transl).unwrap();
     let r = avatar.render(&posed, &camera).unwrap();
-    let mask: Vec<f32> = host(r.alpha.clone()).into_iter().map(|a| f32::from(u8::from(a >= 0.5))).collect();
+    let mask: Vec<f32> = host(r.alpha()).into_iter().map(|a| f32::from(u8::from(a >= 0.5))).collect();
     let targets = host(r.rgb().detach());
 
     let mut start = truth.clone();

@@ -401,10 +401,10 @@ mod gpu {
             )
             .expect("render");
             if backward {
-                let grads = (out.image * self.d_image.clone()).sum().backward();
+                let grads = (out.image() * self.d_image.clone()).sum().backward();
                 std::hint::black_box(means.grad(&grads));
             } else {
-                std::hint::black_box(out.image);
+                std::hint::black_box(out.planes);
             }
             device.sync().expect("sync");
         }

@@ -96,22 +96,22 @@ fn check_scene(scene: &Scene, rot: RotForm, col: ColorForm, seed: u64, cam: Came
             splat_render(means.clone(), rotations, scales.clone(), opacities.clone(), colors, &cam, &opts)
                 .unwrap();
         let tag = |what: &str| format!("{name} {rot:?} {col:?} {what}");
-        close(&tag("image"), &values(out.image.clone()), &want.image, 1e-5);
-        close(&tag("alpha"), &values(out.alpha.clone()), &want.alpha, 1e-5);
+        close(&tag("image"), &values(out.image()), &want.image, 1e-5);
+        close(&tag("alpha"), &values(out.alpha()), &want.alpha, 1e-5);
         // Expected depth is a ratio that amplifies rounding where alpha is tiny: compare the
         // accumulated depth (depth × alpha) instead.
-        let got_alpha = values(out.alpha.clone());
+        let got_alpha = values(out.alpha());
         let acc = |d: &[f32], a: &[f32]| d.iter().zip(a).map(|(d, a)| d * a).collect::<Vec<f32>>();
         close(
             &tag("depth × alpha"),
-            &acc(&values(out.depth.clone()), &got_alpha),
+            &acc(&values(out.depth()), &got_alpha),
             &acc(&want.depth, &want.alpha),
             1e-5,
         );
-        let [c, h, w] = out.image.dims();
-        let loss = (out.image * tensor(&wi, [c, h, w], &device)).sum()
-            + (out.alpha * tensor(&wa, [h, w], &device)).sum()
-            + (out.depth * tensor(&wd, [h, w], &device)).sum();
+        let [c, h, w] = out.image().dims();
+        let loss = (out.image() * tensor(&wi, [c, h, w], &device)).sum()
+            + (out.alpha() * tensor(&wa, [h, w], &device)).sum()
+            + (out.depth() * tensor(&wd, [h, w], &device)).sum();
         let grads = loss.backward();
         let grad = |t: &Tensor<2>| values(t.grad(&grads).expect("gradient"));
         close(&tag("d means"), &grad(&means), &d_want.means, 1e-4);
@@ -196,7 +196,7 @@ fn the_op_chains_with_burn_ops_and_descends() {
                 &opts,
             )
             .unwrap()
-            .image
+            .image()
         };
         let target = render_with(tensor(&s.means, [n, 3], &device)).detach();
         let offset: Vec<f32> = (0..3 * n).map(|i| if i % 3 == 0 { 0.04 } else { -0.03 }).collect();
@@ -234,7 +234,7 @@ fn without_autodiff_the_op_just_renders() {
             &RenderOptions::default(),
         )
         .unwrap();
-        close(&format!("{name} image"), &values(out.image), &want.image, 1e-5);
+        close(&format!("{name} image"), &values(out.image()), &want.image, 1e-5);
     }
 }
 
@@ -272,9 +272,9 @@ fn an_empty_scene_renders_the_background_on_every_backend() {
             &RenderOptions { background: vec![0.25, 0.5], ..Default::default() },
         )
         .unwrap();
-        let image = values(out.image.clone());
+        let image = values(out.image());
         assert!(image[..340].iter().all(|&v| v == 0.25) && image[340..].iter().all(|&v| v == 0.5), "{name}");
-        let grads = (out.image.sum() + out.alpha.sum()).backward();
+        let grads = (out.image().sum() + out.alpha().sum()).backward();
         assert_eq!(means.grad(&grads).map(|g| g.dims()), Some([0, 3]), "{name}");
     }
 }
@@ -318,8 +318,8 @@ fn non_finite_gaussians_are_skipped_and_counted_on_every_backend() {
         };
         let out = render_with(&s.features);
         assert_eq!(values(out.skipped.clone()), [5.0], "{name}: skipped");
-        close(&format!("{name} image"), &values(out.image.clone()), &want.image, 1e-5);
-        let grads = out.image.sum().backward();
+        close(&format!("{name} image"), &values(out.image()), &want.image, 1e-5);
+        let grads = out.image().sum().backward();
         let d = values(means.grad(&grads).expect("gradient"));
         assert!(d.iter().all(|v| v.is_finite()) && d.iter().any(|&v| v != 0.0), "{name}: {d:?}");
         for &i in &bad_ones {

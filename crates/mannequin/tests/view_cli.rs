@@ -307,7 +307,7 @@ fn a_trained_avatar_walks_as_gaussians_in_the_browser() {
         let (pose, transl) = walk.frame_pose(frame, avatar.canonical.num_joints()).unwrap();
         let posed = avatar.pose(&pose, transl).unwrap();
         let rendered = avatar.render(&posed, &camera).unwrap();
-        let alpha: Vec<f32> = rendered.alpha.clone().into_data().iter::<f32>().collect();
+        let alpha: Vec<f32> = rendered.alpha().into_data().iter::<f32>().collect();
         let rgb: Vec<f32> = rendered.rgb().into_data().iter::<f32>().collect();
         let truth: Vec<bool> = alpha.iter().map(|&a| a > 0.5).collect();
         let (shot, coverage) = coverage_at(&mut browser, frame as f64 / 30.0, size);

@@ -17,7 +17,7 @@
 //!     &RenderOptions::default(),
 //! )
 //! .unwrap();
-//! let grads = images.image.sum().backward();
+//! let grads = images.image().sum().backward();
 //! assert!(means.grad(&grads).is_some());
 //! ```
 
@@ -61,18 +61,36 @@ pub enum ColorTensor {
 
 /// What [`splat_render`] returns; the images are differentiable.
 pub struct SplatImages {
-    /// `[C + 2, H, W]`: the next three stacked, as the op renders them. A loss that reads them
+    /// `[C + 2, H, W]`: colour or features over the background (C planes), accumulated opacity
+    /// and expected camera-space depth, stacked as the op renders them. A loss that reads them
     /// in place spares the device the slices (copies, where a plane is not aligned).
     pub planes: Tensor<3>,
-    /// `[C, H, W]` colour or features over the background.
-    pub image: Tensor<3>,
-    /// `[H, W]` accumulated opacity.
-    pub alpha: Tensor<2>,
-    /// `[H, W]` expected camera-space depth.
-    pub depth: Tensor<2>,
     /// `[1]`: how many Gaussians were skipped for a NaN or infinite parameter (a whole number,
     /// exact up to 2²⁴). It stays on the device until read, so it costs nothing unless asked for.
     pub skipped: Tensor<1>,
+}
+
+impl SplatImages {
+    fn plane(&self, k: usize) -> Tensor<2> {
+        let [_, h, w] = self.planes.dims();
+        self.planes.clone().narrow(0, k, 1).reshape([h, w])
+    }
+
+    /// `[C, H, W]` colour or features over the background.
+    pub fn image(&self) -> Tensor<3> {
+        let c = self.planes.dims()[0] - 2;
+        self.planes.clone().narrow(0, 0, c)
+    }
+
+    /// `[H, W]` accumulated opacity.
+    pub fn alpha(&self) -> Tensor<2> {
+        self.plane(self.planes.dims()[0] - 2)
+    }
+
+    /// `[H, W]` expected camera-space depth.
+    pub fn depth(&self) -> Tensor<2> {
+        self.plane(self.planes.dims()[0] - 1)
+    }
 }
 
 /// Backends that can splat. Inputs are flat `[N, k]` float tensors (means, rotations, scales,
@@ -183,7 +201,6 @@ pub fn splat_render(
     };
     camera.validate()?;
     config.options_checked()?;
-    let (h, w, ch) = (camera.height, camera.width, config.channels());
     let (rendered, saved) = <Dispatch as SplatBackend>::splat_forward(
         means.into_dispatch(),
         rotations.into_dispatch(),
@@ -192,12 +209,8 @@ pub fn splat_render(
         colors.into_dispatch(),
         config,
     );
-    let rendered = Tensor::<3>::from_dispatch(rendered);
     Ok(SplatImages {
-        planes: rendered.clone(),
-        image: rendered.clone().narrow(0, 0, ch),
-        alpha: rendered.clone().narrow(0, ch, 1).reshape([h, w]),
-        depth: rendered.narrow(0, ch + 1, 1).reshape([h, w]),
+        planes: Tensor::<3>::from_dispatch(rendered),
         skipped: Tensor::<1>::from_dispatch(saved).narrow(0, saved::SKIPPED, 1),
     })
 }

@@ -42,14 +42,19 @@ impl<B: ImageLossBackend, C: CheckpointStrategy> ImageLossBackend for Autodiff<B
         match ImageLossStep.prepare::<C>([rendered.node()]).compute_bound().stateful() {
             OpsKind::Tracked(mut prep) => {
                 let id = prep.checkpoint(&rendered);
-                let (loss, mse, moments) =
-                    B::image_loss_forward(rendered.into_primitive(), target.clone(), mask.clone(), config.clone());
+                let (loss, mse, moments) = B::image_loss_forward(
+                    rendered.into_primitive(),
+                    target.clone(),
+                    mask.clone(),
+                    config.clone(),
+                );
                 let state = (id, [target, mask, moments.clone()], config);
                 let wrap = FloatTensor::<Self>::new;
                 (prep.finish(state, loss), wrap(mse), wrap(moments))
             }
             OpsKind::UnTracked(prep) => {
-                let (loss, mse, moments) = B::image_loss_forward(rendered.into_primitive(), target, mask, config);
+                let (loss, mse, moments) =
+                    B::image_loss_forward(rendered.into_primitive(), target, mask, config);
                 let wrap = FloatTensor::<Self>::new;
                 (prep.finish(loss), wrap(mse), wrap(moments))
             }
@@ -67,6 +72,13 @@ impl<B: ImageLossBackend, C: CheckpointStrategy> ImageLossBackend for Autodiff<B
         config: ImageLossConfig,
     ) -> FloatTensor<Self> {
         let p = |t: FloatTensor<Self>| t.into_primitive();
-        FloatTensor::<Self>::new(B::image_loss_backward(p(rendered), p(target), p(mask), p(moments), p(grad), config))
+        FloatTensor::<Self>::new(B::image_loss_backward(
+            p(rendered),
+            p(target),
+            p(mask),
+            p(moments),
+            p(grad),
+            config,
+        ))
     }
 }

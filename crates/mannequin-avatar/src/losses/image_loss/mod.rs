@@ -75,7 +75,11 @@ pub fn image_loss(
 ) -> Result<ImageLoss, AvatarError> {
     let [k, h, w] = rendered.dims();
     let [c, th, tw] = target.dims();
-    if [th, tw] != [h, w] || mask.dims() != [h, w] || c < 3 || c > config.alpha_plane || config.alpha_plane >= k
+    if [th, tw] != [h, w]
+        || mask.dims() != [h, w]
+        || c < 3
+        || c > config.alpha_plane
+        || config.alpha_plane >= k
     {
         return Err(AvatarError::Invalid(format!(
             "image loss: rendered planes {:?} (alpha at {}), target {:?} and mask {:?} do not match \
