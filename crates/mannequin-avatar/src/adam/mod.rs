@@ -1,7 +1,7 @@
 //! Adam (Kingma & Ba 2015) over named parameters, each with its own learning rate, with state
 //! that a checkpoint can store and restore exactly, so a resumed run continues bit for bit.
-//! Each parameter's update is one fused backend op (`fused.rs`; Flex in `flex.rs`, CubeCL in
-//! `cube.rs` and `kernels.rs`).
+//! The update is fused (`fused.rs`): one backend op a parameter on Flex (`flex.rs`), one kernel
+//! launch for all of them on CubeCL (`cube.rs` and `kernels.rs`).
 
 mod cube;
 mod flex;
@@ -14,7 +14,7 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
 use crate::params::{Param, to_npy};
-use fused::Coefficients;
+use fused::{Coefficients, Update};
 
 /// First and second moment estimates per parameter, on the parameters' inner device.
 #[derive(Clone, Debug)]
@@ -35,17 +35,21 @@ impl Adam {
     /// where nothing else holds their buffers they are updated in place.
     pub fn update(&mut self, params: &mut [Param], grads: &Gradients) {
         self.step += 1;
+        let mut updated = Vec::new();
+        let mut updates = Vec::new();
         for (k, p) in params.iter_mut().enumerate() {
-            let Some(g) = p.value.grad(grads) else { continue };
-            let coefficients = Coefficients::new(self.step as i32, p.lr);
-            let (value, m, v) = fused::step(
-                take(&mut p.value).inner(),
-                g,
-                take(&mut self.m[k]),
-                take(&mut self.v[k]),
-                coefficients,
-            );
-            (p.value, self.m[k], self.v[k]) = (value.autodiff().require_grad(), m, v);
+            let Some(grad) = p.value.grad(grads) else { continue };
+            updates.push(Update {
+                param: take(&mut p.value).inner(),
+                grad,
+                m: take(&mut self.m[k]),
+                v: take(&mut self.v[k]),
+                coefficients: Coefficients::new(self.step as i32, p.lr),
+            });
+            updated.push(k);
+        }
+        for (k, (value, m, v)) in updated.into_iter().zip(fused::steps(updates)) {
+            (params[k].value, self.m[k], self.v[k]) = (value.autodiff().require_grad(), m, v);
         }
     }
 
