@@ -1,9 +1,9 @@
 //! The MLP on the CubeCL backends. The forward pass is one launch. The backward pass is one
 //! per-row launch (recomputing the activations, as on Flex) and then, per layer, the weight
 //! gradient as a product of the transposed activations by the layer's gradients and the bias
-//! gradient as a sum over rows, each two launches ([`crate::tall_product`]): thirteen launches,
-//! gathers only, nothing read back. Works in f32;
-//! other float types are converted on the way in and out.
+//! gradient as a sum over rows, all six products in two launches ([`crate::tall_product`]):
+//! three launches, gathers only, nothing read back. Works in f32; other float types are
+//! converted on the way in and out.
 
 use burn::backend::TensorMetadata;
 use burn::backend::tensor::FloatTensor;
@@ -13,7 +13,7 @@ use super::MlpBackend;
 use super::kernels::{mlp_backward_rows, mlp_forward};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
-use crate::tall_product::{Left, tall_product};
+use crate::tall_product::{Left, Product, tall_products};
 
 /// The rows `N` and widths `[I, H, O]` of `x` `[N, I]`, `w0` `[I, H]` and `w2` `[H, O]`.
 fn sizes(x: &CubeTensor, w0: &CubeTensor, w2: &CubeTensor) -> (usize, [usize; 3]) {
@@ -107,14 +107,21 @@ impl MlpBackend for CubeBackend {
             o,
         );
         // Layer `l`'s weight gradient is (its input)ᵀ·(its gradient), its bias gradient the sum
-        // of its gradient over rows: products over the N rows into small outputs.
-        let layer = |input: Left, g: CubeTensor, width: usize| {
-            (back(tall_product(input, &g, n, width)), back(tall_product(Left::Ones, &g, n, width)))
+        // of its gradient over rows: products over the N rows into small outputs, all six in
+        // two launches.
+        let product = |a: Left, b: &CubeTensor, width: usize| Product { a, b: b.clone(), k: n, n: width };
+        let sums = tall_products(vec![
+            product(Left::Strided { a: x, columns: i, stride_k: i, stride_m: 1 }, &g0, h),
+            product(Left::Ones, &g0, h),
+            product(Left::Strided { a: h1t, columns: h, stride_k: 1, stride_m: n }, &g1, h),
+            product(Left::Ones, &g1, h),
+            product(Left::Strided { a: h2t, columns: h, stride_k: 1, stride_m: n }, &grad, o),
+            product(Left::Ones, &grad, o),
+        ]);
+        let Ok([dw0, db0, dw1, db1, dw2, db2]) = <[CubeTensor; 6]>::try_from(sums) else {
+            unreachable!("six products give six sums")
         };
-        let rows = Left::Strided { a: x, columns: i, stride_k: i, stride_m: 1 };
-        let (dw0, db0) = layer(rows, g0, h);
-        let (dw1, db1) = layer(Left::Strided { a: h1t, columns: h, stride_k: 1, stride_m: n }, g1, h);
-        let (dw2, db2) = layer(Left::Strided { a: h2t, columns: h, stride_k: 1, stride_m: n }, grad, o);
+        let [dw0, db0, dw1, db1, dw2, db2] = [dw0, db0, dw1, db1, dw2, db2].map(&back);
         (back(dx), dw0, db0, dw1, db1, dw2, db2)
     }
 }

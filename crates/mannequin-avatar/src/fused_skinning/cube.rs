@@ -12,7 +12,7 @@ use cubecl::prelude::*;
 use super::SkinningBackend;
 use super::kernels::{CHAIN, chain_backward, chain_forward, skin_vertices, skin_vertices_backward};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
-use crate::tall_product::{Left, tall_product};
+use crate::tall_product::{Left, Product, tall_products};
 
 /// One unit, for the chain's sequential passes.
 fn single() -> (CubeCount, CubeDim) {
@@ -102,16 +102,17 @@ impl SkinningBackend for CubeBackend {
             u32_of(count),
             u32_of(features),
         );
-        // Σ_v w_vj·outer_v for every joint, and Σ_v g_v in the row of ones.
+        // Σ_v w_vj·outer_v for every joint, and Σ_v g_v in the row of ones; and the correctives'
+        // features: posedirs · v_P's gradient (which is the rest vertices'). Both in two launches.
         let weights = Left::Strided { a: blend, columns: count + 1, stride_k: 1, stride_m: n };
-        let d_transforms = tall_product(weights, &outer, n, 12);
-        // The correctives' features: posedirs · v_P's gradient (which is the rest vertices').
-        let d_features = if features > 0 {
+        let mut products = vec![Product { a: weights, b: outer.clone(), k: n, n: 12 }];
+        if features > 0 {
             let correctives = Left::Strided { a: posedirs, columns: features, stride_k: 1, stride_m: 3 * n };
-            tall_product(correctives, &d_vertices, 3 * n, 1)
-        } else {
-            empty_f32(vec![1, 1], &vertices)
-        };
+            products.push(Product { a: correctives, b: d_vertices.clone(), k: 3 * n, n: 1 });
+        }
+        let mut sums = tall_products(products).into_iter();
+        let d_transforms = sums.next().expect("the transforms' product");
+        let d_features = sums.next().unwrap_or_else(|| empty_f32(vec![1, 1], &vertices));
         let work = empty_f32(vec![count, 12], &vertices);
         let (d_pose, d_joints, d_transl) = (
             empty_f32(vec![1, 3 * count], &vertices),
