@@ -35,6 +35,7 @@ pub mod params;
 pub mod pose_refinement;
 pub mod predict;
 pub mod render_map;
+mod row_totals;
 pub mod run;
 pub mod settings;
 pub mod sh_colour;

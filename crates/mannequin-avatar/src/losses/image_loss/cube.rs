@@ -6,13 +6,12 @@ use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
 use burn::tensor::TensorData;
 
-use burn_cubecl::cubecl::prelude::{CubeCount, CubeDim};
-
-use super::kernels::{SUM_UNITS, loss_shares, map_gradient, pixel_gradients, sum_shares};
+use super::kernels::{loss_shares, map_gradient, pixel_gradients};
 use super::{ImageLossBackend, ImageLossConfig};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::SsimBackend;
 use crate::losses::blur::{TAPS, as_f32};
+use crate::row_totals::row_totals;
 
 type B = CubeBackend;
 
@@ -56,16 +55,8 @@ impl ImageLossBackend for CubeBackend {
             config.lambda_ssim,
             config.lambda_mask,
         );
-        let (loss, mse) = (empty_f32(vec![1], &rendered), empty_f32(vec![1], &rendered));
-        sum_shares::launch(
-            &rendered.client,
-            CubeCount::Static(1, 1, 1),
-            CubeDim::new_1d(SUM_UNITS),
-            share.into_buffer_arg(),
-            loss.clone().into_buffer_arg(),
-            mse.clone().into_buffer_arg(),
-            u32_of(h * w),
-        );
+        let [loss, mse] = <[CubeTensor; 2]>::try_from(row_totals(&share, h * w, 2))
+            .unwrap_or_else(|_| unreachable!("two rows give two totals"));
         (back(loss), back(mse), moments)
     }
 

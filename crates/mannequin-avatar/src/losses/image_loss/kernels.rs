@@ -1,5 +1,5 @@
 //! CubeCL kernels of the image loss, one unit per pixel: the forward writes each pixel's share
-//! of the loss and of the colour MSE, summed after by one cube; the backward adds the L1 and mask
+//! of the loss and of the colour MSE, summed after by one cube (`crate::row_totals`); the backward adds the L1 and mask
 //! terms' signs to the SSIM's gradient and writes every rendered plane's gradient. `sign(0) = 0`,
 //! as Burn's |x| differentiates.
 
@@ -20,13 +20,6 @@ fn sign(x: f32) -> f32 {
     }
     s
 }
-
-/// Units of the cube that sums the shares.
-pub(crate) const SUM_UNITS: u32 = 256;
-
-/// The most pixels the sums take: each unit of the one cube walks `H·W/SUM_UNITS` of them, and
-/// lavapipe stops loops after 65,535 iterations.
-pub(crate) const MAX_PIXELS: usize = SUM_UNITS as usize * 65_535;
 
 /// `share[i] = Σ_c w_c·[(1 − λ)|p − t|/(HW) + λ(1 − S_c)/(H'W')] + λ_m|a − m|/(HW)`, the SSIM
 /// part only where pixel `i` anchors a map entry (`map` is `[C, H − 10, W − 10]`), and
@@ -75,36 +68,6 @@ pub(crate) fn loss_shares(
     }
     share[i] = acc;
     share[plane + i] = squares * inv / 3.0;
-}
-
-/// `loss[0] = Σ share[..len]` and `mse[0] = Σ share[len..2·len]`, by one cube: each unit sums
-/// every `SUM_UNITS`-th share, then unit 0 adds the units' sums. One launch, where Burn's sum
-/// takes two (a fill and an atomic reduction) per total.
-#[cube(launch)]
-pub(crate) fn sum_shares(share: &[f32], loss: &mut [f32], mse: &mut [f32], len: u32) {
-    let u = UNIT_POS_X;
-    let mut parts = Shared::<[f32]>::new_slice(2 * SUM_UNITS as usize);
-    let mut a = 0.0f32;
-    let mut b = 0.0f32;
-    let mut k = u;
-    while k < len {
-        a += share[k as usize];
-        b += share[(len + k) as usize];
-        k += SUM_UNITS;
-    }
-    parts[u as usize] = a;
-    parts[(SUM_UNITS + u) as usize] = b;
-    sync_cube();
-    if u == 0 {
-        let mut ta = 0.0f32;
-        let mut tb = 0.0f32;
-        for r in 0..SUM_UNITS {
-            ta += parts[r as usize];
-            tb += parts[(SUM_UNITS + r) as usize];
-        }
-        loss[0] = ta;
-        mse[0] = tb;
-    }
 }
 
 /// The SSIM map's gradient: `−g·λ·w_c/(H'W')` everywhere in channel c.

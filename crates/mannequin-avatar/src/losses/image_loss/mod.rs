@@ -15,7 +15,7 @@ use burn::tensor::Tensor;
 
 use super::blur::TAPS;
 use crate::AvatarError;
-use kernels::MAX_PIXELS;
+use crate::row_totals::MAX_LEN;
 
 /// The weights of the terms, and where the rendered alpha is.
 #[derive(Debug, Clone)]
@@ -90,9 +90,9 @@ pub fn image_loss(
             mask.dims()
         )));
     }
-    if h < TAPS || w < TAPS || config.weights.len() != c || h * w > MAX_PIXELS {
+    if h < TAPS || w < TAPS || config.weights.len() != c || h * w > MAX_LEN {
         return Err(AvatarError::Invalid(format!(
-            "image loss: needs {TAPS} ≤ H, W, H·W ≤ {MAX_PIXELS} and one weight per target channel; \
+            "image loss: needs {TAPS} ≤ H, W, H·W ≤ {MAX_LEN} and one weight per target channel; \
              got {:?} and {} weights",
             target.dims(),
             config.weights.len()

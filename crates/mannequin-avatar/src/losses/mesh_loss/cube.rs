@@ -14,6 +14,7 @@ use super::tables::{Tables, tables};
 use super::{HostTerm, MeshLoss, MeshLossBackend};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
+use crate::row_totals::row_totals;
 
 type B = CubeBackend;
 
@@ -93,7 +94,10 @@ impl MeshLossBackend for CubeBackend {
             _ if elements(&loss) == 0 => return back(B::float_zeros([1].into(), &v.device, FloatDType::F32)),
             term => element_terms(&v, &t, term, elements(&loss), false),
         };
-        back(B::float_sum(shares))
+        let n = shares.shape().num_elements();
+        let [total] = <[CubeTensor; 1]>::try_from(row_totals(&shares, n, 1))
+            .unwrap_or_else(|_| unreachable!("one row gives one total"));
+        back(total)
     }
 
     fn mesh_loss_backward(
