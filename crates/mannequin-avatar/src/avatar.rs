@@ -22,6 +22,7 @@ use crate::host_ops;
 use crate::ihuman;
 use crate::mesh_gaussians::{Faces, GaussianGeometry, MeshIndex, face_gaussians, vertex_gaussians};
 use crate::params::{Param, tensor_from};
+use crate::render_features::{FeaturesConfig, render_features};
 use crate::sh_colour::{ColourConfig, colour_convention, sh_colour, sh_colour_tensors};
 use mannequin_io::rng::SplitMix64;
 
@@ -382,13 +383,31 @@ impl Avatar {
         }
     }
 
+    /// Per-Gaussian colour seen from `camera` and camera-space normal, [G, 6]: one fused op on a
+    /// GPU for Tavatar, where the composition costs launches.
+    fn features(&self, g: &GaussianGeometry, camera: &Camera) -> Result<Tensor<2>, AvatarError> {
+        if self.config.method == Method::Tavatar && host_ops::on_cube(&self.device) {
+            let e = &camera.extrinsic;
+            let config = FeaturesConfig {
+                colour: ColourConfig {
+                    eye: camera.centre().map(|x| x as f32),
+                    degree: self.config.sh_degree,
+                },
+                rotation: std::array::from_fn(|k| e[k / 3][k % 3] as f32),
+            };
+            let coeffs = self.sh_coefficients().expect("Tavatar has SH");
+            return Ok(render_features(g.means.clone(), coeffs, g.normals.clone(), &config));
+        }
+        let rgb = self.colours(g, camera.centre())?;
+        let normals_cam = g.normals.clone().matmul(rotation_transposed(camera, &self.device));
+        Ok(Tensor::cat(vec![rgb, normals_cam], 1))
+    }
+
     /// Renders colour over white and camera-space normals over zero in one pass of six channels.
     pub fn render(&self, posed: &Posed, camera: &Camera) -> Result<Rendered, AvatarError> {
         let g = &posed.gaussians;
         let n = g.len();
-        let rgb = self.colours(g, camera.centre())?;
-        let normals_cam = g.normals.clone().matmul(rotation_transposed(camera, &self.device));
-        let features = Tensor::cat(vec![rgb, normals_cam], 1);
+        let features = self.features(g, camera)?;
         let options = RenderOptions {
             background: vec![WHITE[0], WHITE[1], WHITE[2], 0.0, 0.0, 0.0],
             dilation: self.config.dilation,

@@ -34,6 +34,7 @@ pub mod options;
 pub mod params;
 pub mod pose_refinement;
 pub mod predict;
+pub mod render_features;
 pub mod render_map;
 mod row_totals;
 pub mod run;

@@ -31,6 +31,30 @@ fn value(coeffs: &[f32], basis: &Array<f32>, i: usize, ch: usize, #[comptime] de
     v
 }
 
+/// Gaussian `i`'s colours `[max(v, 0)]` into `out[at..at + 3]`, and its direction's basis.
+#[cube]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn write_colour(
+    means: &[f32],
+    coeffs: &[f32],
+    out: &mut [f32],
+    i: usize,
+    at: usize,
+    ex: f32,
+    ey: f32,
+    ez: f32,
+    #[comptime] degree: u32,
+) {
+    let mut d = Array::<f32>::new(3usize);
+    direction(means, i, ex, ey, ez, &mut d);
+    let mut basis = Array::<f32>::new(16usize);
+    sh_basis(d[0], d[1], d[2], &mut basis, degree);
+    #[unroll]
+    for ch in 0..3usize {
+        out[at + ch] = f32::max(value(coeffs, &basis, i, ch, degree), 0.0f32);
+    }
+}
+
 #[cube(launch)]
 pub(crate) fn colour_forward(
     means: &[f32],
@@ -46,36 +70,28 @@ pub(crate) fn colour_forward(
     if i >= n as usize {
         terminate!();
     }
-    let mut d = Array::<f32>::new(3usize);
-    direction(means, i, ex, ey, ez, &mut d);
-    let mut basis = Array::<f32>::new(16usize);
-    sh_basis(d[0], d[1], d[2], &mut basis, degree);
-    #[unroll]
-    for ch in 0..3usize {
-        out[3 * i + ch] = f32::max(value(coeffs, &basis, i, ch, degree), 0.0f32);
-    }
+    write_colour(means, coeffs, out, i, 3 * i, ex, ey, ez, degree);
 }
 
-/// The gradient passes the clamp where the colour is positive; the means get it through the
-/// view direction, projected off the direction (normalisation): `(g − d (d·g)) / |v|`.
-#[cube(launch)]
+/// Gaussian `i`'s gradients of its mean and coefficients given its colours' gradient
+/// `grad[at..at + 3]`. The gradient passes the clamp where the colour is positive; the means get
+/// it through the view direction, projected off the direction (normalisation):
+/// `(g − d (d·g)) / |v|`.
+#[cube]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn colour_backward(
+pub(crate) fn colour_gradients(
     means: &[f32],
     coeffs: &[f32],
     grad: &[f32],
     d_means: &mut [f32],
     d_coeffs: &mut [f32],
-    n: u32,
+    i: usize,
+    at: usize,
     ex: f32,
     ey: f32,
     ez: f32,
     #[comptime] degree: u32,
 ) {
-    let i = ABSOLUTE_POS;
-    if i >= n as usize {
-        terminate!();
-    }
     let k = comptime!(((degree + 1) * (degree + 1)) as usize);
     let mut d = Array::<f32>::new(3usize);
     let r = direction(means, i, ex, ey, ez, &mut d);
@@ -84,7 +100,7 @@ pub(crate) fn colour_backward(
     let mut g = Array::<f32>::new(3usize);
     #[unroll]
     for ch in 0..3usize {
-        g[ch] = select(value(coeffs, &basis, i, ch, degree) > 0.0f32, grad[3 * i + ch], 0.0f32);
+        g[ch] = select(value(coeffs, &basis, i, ch, degree) > 0.0f32, grad[at + ch], 0.0f32);
     }
     let mut per_basis = Array::<f32>::new(16usize);
     #[unroll]
@@ -112,4 +128,25 @@ pub(crate) fn colour_backward(
             d_means[3 * i + a] = (gd[a] - d[a] * along) / r;
         }
     }
+}
+
+#[cube(launch)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn colour_backward(
+    means: &[f32],
+    coeffs: &[f32],
+    grad: &[f32],
+    d_means: &mut [f32],
+    d_coeffs: &mut [f32],
+    n: u32,
+    ex: f32,
+    ey: f32,
+    ez: f32,
+    #[comptime] degree: u32,
+) {
+    let i = ABSOLUTE_POS;
+    if i >= n as usize {
+        terminate!();
+    }
+    colour_gradients(means, coeffs, grad, d_means, d_coeffs, i, 3 * i, ex, ey, ez, degree);
 }

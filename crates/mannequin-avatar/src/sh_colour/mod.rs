@@ -9,7 +9,7 @@ mod autodiff;
 mod cube;
 mod flex;
 mod host;
-mod kernels;
+pub(crate) mod kernels;
 
 use burn::backend::tensor::FloatTensor;
 use burn::backend::{Backend, Dispatch, backend_extension};
