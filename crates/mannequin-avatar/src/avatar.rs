@@ -74,6 +74,8 @@ pub struct Avatar {
     /// iHuman's colour encoder over canonical face centroids.
     colour_field: Option<Field>,
     slots: Slots,
+    /// Opacity 1 for every Gaussian, made once: a fill each render is a GPU launch.
+    full_opacity: Tensor<1>,
 }
 
 /// A posed avatar: its mesh and Gaussians, still differentiable.
@@ -195,7 +197,15 @@ impl Avatar {
         let skin_rig = host_ops::on_cube(device)
             .then(|| SkinRig::new(&canonical.weights, v, posedirs.as_ref(), &canonical.parents, device))
             .transpose()?;
+        let gaussians = match config.method {
+            Method::Tavatar => {
+                usize::from(config.face_gaussians) * canonical.faces.len()
+                    + usize::from(config.vertex_gaussians) * v
+            }
+            Method::Ihuman => canonical.faces.len(),
+        };
         Ok(Self {
+            full_opacity: Tensor::<1>::ones([gaussians], device),
             skin_rig,
             index,
             vertices,
@@ -222,13 +232,7 @@ impl Avatar {
     }
 
     pub fn num_gaussians(&self) -> usize {
-        let (v, f) = (self.canonical.num_vertices(), self.canonical.faces.len());
-        match self.config.method {
-            Method::Tavatar => {
-                usize::from(self.config.face_gaussians) * f + usize::from(self.config.vertex_gaussians) * v
-            }
-            Method::Ihuman => f,
-        }
+        self.full_opacity.dims()[0]
     }
 
     fn param(&self, slot: Option<usize>) -> Option<Tensor<2>> {
@@ -416,7 +420,13 @@ impl Avatar {
         let opacities = if self.config.antialiased {
             antialias::compensation(g, camera, self.config.dilation)
         } else {
-            Tensor::<1>::ones([n], &self.device)
+            if n != self.num_gaussians() {
+                return Err(AvatarError::Invalid(format!(
+                    "render: {n} posed Gaussians for an avatar of {}",
+                    self.num_gaussians()
+                )));
+            }
+            self.full_opacity.clone()
         };
         let out = splat_render(
             g.means.clone(),

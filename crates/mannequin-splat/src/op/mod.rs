@@ -65,9 +65,8 @@ pub struct SplatImages {
     /// and expected camera-space depth, stacked as the op renders them. A loss that reads them
     /// in place spares the device the slices (copies, where a plane is not aligned).
     pub planes: Tensor<3>,
-    /// `[1]`: how many Gaussians were skipped for a NaN or infinite parameter (a whole number,
-    /// exact up to 2²⁴). It stays on the device until read, so it costs nothing unless asked for.
-    pub skipped: Tensor<1>,
+    /// The op's saved state, where the count of skipped Gaussians is.
+    saved: Tensor<1>,
 }
 
 impl SplatImages {
@@ -90,6 +89,13 @@ impl SplatImages {
     /// `[H, W]` expected camera-space depth.
     pub fn depth(&self) -> Tensor<2> {
         self.plane(self.planes.dims()[0] - 1)
+    }
+
+    /// `[1]`: how many Gaussians were skipped for a NaN or infinite parameter (a whole number,
+    /// exact up to 2²⁴). It stays on the device until asked for (a slice of the saved state: a
+    /// copy on a GPU).
+    pub fn skipped(&self) -> Tensor<1> {
+        self.saved.clone().narrow(0, saved::SKIPPED, 1)
     }
 }
 
@@ -209,8 +215,5 @@ pub fn splat_render(
         colors.into_dispatch(),
         config,
     );
-    Ok(SplatImages {
-        planes: Tensor::<3>::from_dispatch(rendered),
-        skipped: Tensor::<1>::from_dispatch(saved).narrow(0, saved::SKIPPED, 1),
-    })
+    Ok(SplatImages { planes: Tensor::<3>::from_dispatch(rendered), saved: Tensor::<1>::from_dispatch(saved) })
 }
