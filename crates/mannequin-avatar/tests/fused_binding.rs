@@ -117,7 +117,8 @@ fn fused_binding_matches_the_tensor_composition_and_its_autodiff() {
 
 /// The op on the GPU backend (lavapipe where there is no GPU) against the Flex op, through
 /// autodiff: every plane's values, and the vertex gradient of a random upstream gradient on each
-/// plane alone (at its own scale), with every ablation's set of Gaussians. Both run in f32 but
+/// plane alone (at its own scale) and on all four at once (their gradients gather in one buffer
+/// on the GPU), with every ablation's set of Gaussians. Both run in f32 but
 /// sum in different orders.
 #[test]
 fn fused_binding_on_wgpu_matches_flex() {
@@ -137,14 +138,21 @@ fn fused_binding_on_wgpu_matches_flex() {
                     .require_grad()
             };
             let values = outputs(bind(vertices(), &config)).map(host);
-            let mut at = 0;
-            let grads = std::array::from_fn::<_, 4, _>(|k| {
+            // Each plane alone (the others get no gradient), then all four at once.
+            let grads = std::array::from_fn::<_, 5, _>(|which| {
                 let v = vertices();
-                let plane = outputs(bind(v.clone(), &config))[k].clone();
-                let width = plane.dims()[1];
-                let part = TensorData::new(w[at..at + g * width].to_vec(), [g, width]);
-                at += g * width;
-                let grads = (plane * Tensor::<2>::from_data(part, (&device, DType::F32))).sum().backward();
+                let mut at = 0;
+                let mut loss = None;
+                for (k, plane) in outputs(bind(v.clone(), &config)).into_iter().enumerate() {
+                    let width = plane.dims()[1];
+                    let part = TensorData::new(w[at..at + g * width].to_vec(), [g, width]);
+                    at += g * width;
+                    if which == k || which == 4 {
+                        let term = (plane * Tensor::<2>::from_data(part, (&device, DType::F32))).sum();
+                        loss = Some(loss.map_or(term.clone(), |l| l + term));
+                    }
+                }
+                let grads = loss.expect("a plane").backward();
                 host(v.grad(&grads).expect("a vertex gradient"))
             });
             (values, grads)
@@ -157,5 +165,7 @@ fn fused_binding_on_wgpu_matches_flex() {
             let through = format!("wgpu {what}: vertex gradient through {name}");
             assert_close(&through, &got_grads[k], &want_grads[k], 1e-4);
         }
+        let through = format!("wgpu {what}: vertex gradient through all four");
+        assert_close(&through, &got_grads[4], &want_grads[4], 1e-4);
     }
 }

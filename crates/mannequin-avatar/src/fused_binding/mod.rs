@@ -9,6 +9,7 @@ mod cube;
 mod flex;
 mod host;
 mod kernels;
+mod planes;
 
 use std::sync::Arc;
 
@@ -78,8 +79,12 @@ pub fn bind(vertices: Tensor<2>, config: &BindConfig) -> GaussianGeometry {
         config.clone(),
     ));
     let starts = plane_starts(g);
-    let [means, frames, scales, normals] =
-        std::array::from_fn(|p| planes.clone().narrow(0, starts[p], PLANES[p] * g));
+    let spans = std::array::from_fn(|p| (starts[p], PLANES[p] * g));
+    let [means, frames, scales, normals] = if crate::host_ops::on_cube(&planes.device()) {
+        planes::planes(planes, spans)
+    } else {
+        spans.map(|(start, len)| planes.clone().narrow(0, start, len))
+    };
     GaussianGeometry {
         means: means.reshape([g, 3]),
         frames: frames.reshape([g, 3, 3]),
