@@ -1,6 +1,9 @@
 //! The fused update as one CubeCL kernel, generic over the float type: one unit per element,
 //! so no unit reads what another writes and there are no loops (lavapipe caps loop trips).
 
+// Kernels index their buffers: iterator forms do not exist in CubeCL.
+#![allow(clippy::needless_range_loop)]
+
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
 

@@ -3,8 +3,8 @@
 //! output) sums the chunks. Product `p`'s sizes are `table[FIELDS·p ..]`: K, M, N, a's strides
 //! along K and M, and whether `a` is a column of ones (as `u32` bit patterns).
 
-// Kernels index their buffers: iterator forms do not exist in CubeCL.
-#![allow(clippy::needless_range_loop)]
+// Kernels index their buffers: iterator forms do not exist in CubeCL; nor does `div_ceil`.
+#![allow(clippy::needless_range_loop, clippy::manual_div_ceil)]
 
 use burn_cubecl::cubecl;
 use cubecl::prelude::*;
