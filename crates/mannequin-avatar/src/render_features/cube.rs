@@ -6,23 +6,14 @@ use burn::backend::ops::FloatTensorOps;
 use burn::backend::tensor::FloatTensor;
 use burn::backend::wgpu::{CubeBackend, CubeTensor};
 use burn::tensor::TensorData;
-use mannequin_splat::sh::{MAX_DEGREE, basis_len};
 
 use super::kernels::{features_backward, features_forward};
 use super::{FeaturesBackend, FeaturesConfig};
 use crate::cube_launch::{empty_f32, per_element, u32_of};
 use crate::losses::blur::as_f32;
+use crate::sh_colour::cube::sizes;
 
 type B = CubeBackend;
-
-/// The Gaussian count and the comptime degree, checked against the coefficients' width.
-fn sizes(means: &CubeTensor, coeffs: &CubeTensor, config: &FeaturesConfig) -> (usize, u32) {
-    let degree = config.colour.degree;
-    assert!(degree <= MAX_DEGREE, "SH degree {degree} above {MAX_DEGREE}");
-    let n = means.shape()[0];
-    assert_eq!(coeffs.shape().to_vec(), [n, 3 * basis_len(degree)], "SH coefficients' shape");
-    (n, u32::try_from(degree).expect("degree ≤ 3"))
-}
 
 fn rotation(config: &FeaturesConfig, like: &CubeTensor) -> CubeTensor {
     B::float_from_data(TensorData::new(config.rotation.to_vec(), [9]), &like.device)
@@ -35,7 +26,7 @@ impl FeaturesBackend for CubeBackend {
         normals: FloatTensor<Self>,
         config: FeaturesConfig,
     ) -> FloatTensor<Self> {
-        let (n, degree) = sizes(&means, &coeffs, &config);
+        let (n, degree) = sizes(&means, &coeffs, config.colour.degree);
         let (means, back) = as_f32(means);
         let [coeffs, normals] = [coeffs, normals].map(|t| as_f32(t).0);
         let out = empty_f32(vec![n, 6], &means);
@@ -65,7 +56,7 @@ impl FeaturesBackend for CubeBackend {
         grad: FloatTensor<Self>,
         config: FeaturesConfig,
     ) -> (FloatTensor<Self>, FloatTensor<Self>, FloatTensor<Self>) {
-        let (n, degree) = sizes(&means, &coeffs, &config);
+        let (n, degree) = sizes(&means, &coeffs, config.colour.degree);
         let (means, back) = as_f32(means);
         let [coeffs, grad] = [coeffs, grad].map(|t| as_f32(t).0);
         let d_means = empty_f32(vec![n, 3], &means);

@@ -16,12 +16,11 @@ use crate::losses::blur::as_f32;
 type B = CubeBackend;
 
 /// The Gaussian count and the comptime degree, checked against the coefficients' width.
-fn sizes(means: &CubeTensor, coeffs: &CubeTensor, config: &ColourConfig) -> (usize, u32) {
-    assert!(config.degree <= MAX_DEGREE, "SH degree {} above {MAX_DEGREE}", config.degree);
+pub(crate) fn sizes(means: &CubeTensor, coeffs: &CubeTensor, degree: usize) -> (usize, u32) {
+    assert!(degree <= MAX_DEGREE, "SH degree {degree} above {MAX_DEGREE}");
     let n = means.shape()[0];
-    assert_eq!(coeffs.shape().to_vec(), [n, 3 * basis_len(config.degree)], "SH coefficients' shape");
-    let degree = u32::try_from(config.degree).expect("degree ≤ 3");
-    (n, degree)
+    assert_eq!(coeffs.shape().to_vec(), [n, 3 * basis_len(degree)], "SH coefficients' shape");
+    (n, u32::try_from(degree).expect("degree ≤ 3"))
 }
 
 impl ColourBackend for CubeBackend {
@@ -30,7 +29,7 @@ impl ColourBackend for CubeBackend {
         coeffs: FloatTensor<Self>,
         config: ColourConfig,
     ) -> FloatTensor<Self> {
-        let (n, degree) = sizes(&means, &coeffs, &config);
+        let (n, degree) = sizes(&means, &coeffs, config.degree);
         let (means, back) = as_f32(means);
         let (coeffs, _) = as_f32(coeffs);
         let out = B::float_empty([n, 3].into(), &means.device, FloatDType::F32);
@@ -58,7 +57,7 @@ impl ColourBackend for CubeBackend {
         grad: FloatTensor<Self>,
         config: ColourConfig,
     ) -> (FloatTensor<Self>, FloatTensor<Self>) {
-        let (n, degree) = sizes(&means, &coeffs, &config);
+        let (n, degree) = sizes(&means, &coeffs, config.degree);
         let (means, back) = as_f32(means);
         let (coeffs, _) = as_f32(coeffs);
         let (grad, _) = as_f32(grad);

@@ -6,7 +6,7 @@
 //! [`sh_colour_tensors`] is the composition).
 
 mod autodiff;
-mod cube;
+pub(crate) mod cube;
 mod flex;
 mod host;
 pub(crate) mod kernels;
