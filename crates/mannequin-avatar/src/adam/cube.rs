@@ -12,7 +12,7 @@ use burn_cubecl::cubecl::calculate_cube_count_elemwise;
 use burn_cubecl::cubecl::prelude::{CubeDim, InputScalar, SequenceArg};
 use burn_cubecl::kernel::into_contiguous;
 
-use super::fused::Coefficients;
+use super::coefficients::Coefficients;
 use super::kernels::adam_steps;
 
 /// Units per cube. The cube count spreads over the grid's dimensions when one would exceed its

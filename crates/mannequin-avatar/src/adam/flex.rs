@@ -12,7 +12,8 @@ use burn::backend::tensor::FloatTensor;
 use burn::tensor::DType;
 use rayon::prelude::*;
 
-use super::fused::{AdamBackend, Coefficients};
+use super::coefficients::Coefficients;
+use super::fused::AdamBackend;
 
 /// Elements per task: four blocks of this many f32 stay in L2 between the copy and the update.
 const BLOCK: usize = 8192;

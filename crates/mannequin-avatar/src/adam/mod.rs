@@ -3,6 +3,7 @@
 //! The update is fused (`fused.rs`): one backend op a parameter on Flex (`flex.rs`), one kernel
 //! launch for all of them on CubeCL (`cube.rs` and `kernels.rs`).
 
+mod coefficients;
 mod cube;
 mod flex;
 mod fused;
@@ -14,7 +15,8 @@ use mannequin_io::{NpyArray, Npz, NpzWriter};
 
 use crate::error::AvatarError;
 use crate::params::{Param, to_npy};
-use fused::{Coefficients, Update};
+use coefficients::Coefficients;
+use fused::Update;
 
 /// First and second moment estimates per parameter, on the parameters' inner device.
 #[derive(Clone, Debug)]
