@@ -260,13 +260,15 @@ impl Scene {
     /// vertex touches y = 0, and plays the garments through it with the cloth simulator, from
     /// rest, after settling into the first frame. The simulator sees `subframes` poses per frame,
     /// blended between the frames: its body moves linearly between the poses it is given, which
-    /// for a swinging limb far apart cuts the corner through the cloth.
+    /// for a swinging limb far apart cuts the corner through the cloth. `self_collision` turns
+    /// the cloth–cloth contacts on.
     pub fn pose(
         &self,
         model: &BodyModel,
         poses: &[f32],
         fps: f32,
         subframes: usize,
+        self_collision: bool,
     ) -> Result<PosedSequence, SynthError> {
         let frames = poses.len() / 72;
         let dense: Vec<f32> = (0..frames)
@@ -279,11 +281,17 @@ impl Scene {
                 })
             })
             .collect();
-        let played = self.play(model, &dense, fps * subframes as f32)?;
+        let played = self.play(model, &dense, fps * subframes as f32, self_collision)?;
         Ok(played.select(&(0..frames).map(|f| f * subframes).collect::<Vec<_>>()))
     }
 
-    fn play(&self, model: &BodyModel, poses: &[f32], fps: f32) -> Result<PosedSequence, SynthError> {
+    fn play(
+        &self,
+        model: &BodyModel,
+        poses: &[f32],
+        fps: f32,
+        self_collision: bool,
+    ) -> Result<PosedSequence, SynthError> {
         let frames = poses.len() / 72;
         let still = pose_frames(model, &self.shaped, poses, &vec![0.0; 3 * frames])?;
         let lift: Vec<f32> = (0..frames)
@@ -313,7 +321,7 @@ impl Scene {
         let named: Vec<(&str, &Dressed)> = self.worn.iter().zip(&dressed).map(|(w, d)| (w.name, d)).collect();
         let wearer = Wearer { faces: &self.body_faces, frames: &body_frames, schedule: &schedule, fps };
         let settings =
-            Settings { substeps: Settings::substeps_at(fps), self_collision: false, ..Settings::default() };
+            Settings { substeps: Settings::substeps_at(fps), self_collision, ..Settings::default() };
         let layers =
             wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |_| Ok(()))
                 .map_err(fail)?;

@@ -35,6 +35,10 @@ pub struct Args {
     /// Frames of the walk animation.
     #[arg(long, default_value_t = 60)]
     walk_frames: usize,
+    /// Simulate the subject's garments without cloth–cloth contacts (faster; folds and layers
+    /// may pass through each other).
+    #[arg(long)]
+    no_self_collision: bool,
 }
 
 /// Runs the stages, each through `run_verb` (a verb's command line, without the binary's name).
@@ -50,23 +54,24 @@ pub fn run(args: Args, run_verb: impl Fn(&[&str]) -> Result<()>) -> Result<()> {
     let images = path("subject/images");
     let (eval_json, walk_dir) = (path("eval.json"), path("walk"));
     let (glb, splats, squat) = (path("avatar.glb"), path("avatar_gaussians.ply"), path("avatar_squat.obj"));
+    let mut synth = vec![
+        "synth",
+        "--seed",
+        &seed,
+        "--size",
+        &size,
+        "--frames",
+        &capture_frames,
+        "--train",
+        &synth_train,
+        "--out",
+        &subject,
+    ];
+    if args.no_self_collision {
+        synth.push("--no-self-collision");
+    }
     let stages: Vec<(&str, Vec<&str>)> = vec![
-        (
-            "subject",
-            vec![
-                "synth",
-                "--seed",
-                &seed,
-                "--size",
-                &size,
-                "--frames",
-                &capture_frames,
-                "--train",
-                &synth_train,
-                "--out",
-                &subject,
-            ],
-        ),
+        ("subject", synth),
         ("capture", vec!["capture", "--frames", &images, "--out", &captured, "--restart"]),
         (
             "train",

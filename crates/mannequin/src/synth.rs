@@ -30,6 +30,10 @@ pub struct Args {
     /// Of those, the first N form the training split; the rest are the test split.
     #[arg(long, default_value_t = SynthOptions::default().train_frames)]
     train: usize,
+    /// Simulate the garments without cloth–cloth contacts: about 2.5× faster, but folds and
+    /// layers may pass through each other.
+    #[arg(long)]
+    no_self_collision: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -41,6 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         supersample: args.supersample,
         capture_frames: args.frames,
         train_frames: args.train,
+        self_collision: !args.no_self_collision,
         ..SynthOptions::default()
     };
     let progress = bar(options.total_frames() as u64, "synth");

@@ -17,7 +17,18 @@ fn subject() -> &'static Path {
     static DATA: OnceLock<PathBuf> = OnceLock::new();
     DATA.get_or_init(|| {
         let data = scratch("batch_subject").join("subject");
-        let synth = ["synth", "--seed", "1", "--size", "64", "--supersample", "1", "--frames", "10"];
+        let synth = [
+            "synth",
+            "--no-self-collision",
+            "--seed",
+            "1",
+            "--size",
+            "64",
+            "--supersample",
+            "1",
+            "--frames",
+            "10",
+        ];
         ok(mannequin(&[&synth[..], &["--train", "8", "--body", "default-lod1", "--out", s(&data)]].concat()));
         data
     })

@@ -56,7 +56,18 @@ fn a_killed_array_task_resumes_and_nothing_finished_runs_again() {
     let dir = scratch("batch_slurm");
     // One tiny subject serves all three people: a task only reads its input.
     let data = dir.join("subject");
-    let synth = ["synth", "--seed", "2", "--size", "64", "--supersample", "1", "--frames", "10"];
+    let synth = [
+        "synth",
+        "--no-self-collision",
+        "--seed",
+        "2",
+        "--size",
+        "64",
+        "--supersample",
+        "1",
+        "--frames",
+        "10",
+    ];
     ok(mannequin(&[&synth[..], &["--train", "8", "--body", "default-lod1", "--out", s(&data)]].concat()));
     let rows: Vec<String> = ["ada", "ben", "cy"]
         .iter()

@@ -25,6 +25,7 @@ fn subject() -> &'static Path {
         let dir = scratch("capture_subject").join("data");
         ok(mannequin(&[
             "synth",
+            "--no-self-collision",
             "--seed",
             "2",
             "--size",

@@ -20,6 +20,7 @@ fn demo_trains_evaluates_animates_and_exports() {
         "10",
         "--walk-frames",
         "3",
+        "--no-self-collision",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for f in [

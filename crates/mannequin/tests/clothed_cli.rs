@@ -44,6 +44,7 @@ fn a_clothed_avatar_trains_exports_and_scores_its_garment_layers() {
     // Seed 0 wears pants under a T-shirt.
     ok(mannequin(&[
         "synth",
+        "--no-self-collision",
         "--seed",
         "0",
         "--size",

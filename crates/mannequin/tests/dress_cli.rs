@@ -196,6 +196,7 @@ fn garment_fit_brings_the_template_closer_to_the_label_maps() {
     let data = dir.join("data");
     ok(mannequin(&[
         "synth",
+        "--no-self-collision",
         "--seed",
         "0",
         "--size",

@@ -20,6 +20,7 @@ fn subject(dir: &Path, seed: &str) -> PathBuf {
     let data = dir.join(format!("truth-{seed}"));
     ok(mannequin(&[
         "synth",
+        "--no-self-collision",
         "--seed",
         seed,
         "--size",

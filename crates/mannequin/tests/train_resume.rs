@@ -25,7 +25,18 @@ fn data() -> &'static Path {
     static DATA: OnceLock<PathBuf> = OnceLock::new();
     DATA.get_or_init(|| {
         let data = scratch("train-resume-data").join("subject");
-        let args = ["synth", "--seed", "3", "--size", "64", "--supersample", "1", "--frames", "10"];
+        let args = [
+            "synth",
+            "--no-self-collision",
+            "--seed",
+            "3",
+            "--size",
+            "64",
+            "--supersample",
+            "1",
+            "--frames",
+            "10",
+        ];
         let more = ["--train", "8", "--body", "default-lod1", "--out", s(&data)];
         ok(command(&[&args[..], &more[..]].concat()).output().unwrap());
         data

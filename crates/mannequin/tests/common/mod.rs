@@ -55,6 +55,7 @@ pub fn tiny_avatar(dir: &Path) -> (PathBuf, PathBuf) {
     let (data, model) = (dir.join("data"), dir.join("model"));
     ok(mannequin(&[
         "synth",
+        "--no-self-collision",
         "--seed",
         "1",
         "--size",
