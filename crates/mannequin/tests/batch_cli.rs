@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use common::{copy_dir, mannequin, ok, one_line_error, read_json, s, scratch};
+use common::{copy_dir, mannequin, ok, one_line_error, read_json, s, scratch, tiny_subject};
 
 /// A tiny synthetic dataset (64², 10 frames, the light body), made once for every test here:
 /// batch runs only read their inputs, so people may share one.
@@ -17,19 +17,7 @@ fn subject() -> &'static Path {
     static DATA: OnceLock<PathBuf> = OnceLock::new();
     DATA.get_or_init(|| {
         let data = scratch("batch_subject").join("subject");
-        let synth = [
-            "synth",
-            "--no-self-collision",
-            "--seed",
-            "1",
-            "--size",
-            "64",
-            "--supersample",
-            "1",
-            "--frames",
-            "10",
-        ];
-        ok(mannequin(&[&synth[..], &["--train", "8", "--body", "default-lod1", "--out", s(&data)]].concat()));
+        ok(mannequin(&tiny_subject("1", &data)));
         data
     })
 }

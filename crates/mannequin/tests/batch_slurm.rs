@@ -11,7 +11,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::{mannequin, ok, read_json, s, scratch};
+use common::{mannequin, ok, read_json, s, scratch, tiny_subject};
 
 /// Whether a Slurm controller answers here.
 fn slurm_up() -> bool {
@@ -56,19 +56,7 @@ fn a_killed_array_task_resumes_and_nothing_finished_runs_again() {
     let dir = scratch("batch_slurm");
     // One tiny subject serves all three people: a task only reads its input.
     let data = dir.join("subject");
-    let synth = [
-        "synth",
-        "--no-self-collision",
-        "--seed",
-        "2",
-        "--size",
-        "64",
-        "--supersample",
-        "1",
-        "--frames",
-        "10",
-    ];
-    ok(mannequin(&[&synth[..], &["--train", "8", "--body", "default-lod1", "--out", s(&data)]].concat()));
+    ok(mannequin(&tiny_subject("2", &data)));
     let rows: Vec<String> = ["ada", "ben", "cy"]
         .iter()
         .map(|id| {

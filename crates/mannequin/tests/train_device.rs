@@ -3,7 +3,7 @@
 //! one backward pass and Adam step, so the two devices must agree on both.
 
 mod common;
-use common::{mannequin, ok, s, scratch};
+use common::{mannequin, ok, s, scratch, tiny_subject};
 
 /// The loss logged at each checkpoint of a run.
 fn losses(stderr: &[u8]) -> Vec<f64> {
@@ -21,21 +21,7 @@ fn losses(stderr: &[u8]) -> Vec<f64> {
 fn gpu_training_follows_the_cpu() {
     let dir = scratch("train-device");
     let data = dir.join("subject");
-    let synth = [
-        "synth",
-        "--no-self-collision",
-        "--seed",
-        "3",
-        "--size",
-        "64",
-        "--supersample",
-        "1",
-        "--frames",
-        "10",
-        "--train",
-        "8",
-    ];
-    ok(mannequin(&[&synth[..], &["--body", "default-lod1", "--out", s(&data)]].concat()));
+    ok(mannequin(&tiny_subject("3", &data)));
     let run = |device: &str| {
         let out = dir.join(device);
         let args = ["train", "--data", s(&data), "--out", s(&out), "--body", "default-lod1"];

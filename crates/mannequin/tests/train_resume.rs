@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 use mannequin_io::{NpyData, Npz};
 
 mod common;
-use common::{ok, s, scratch};
+use common::{ok, s, scratch, tiny_subject};
 
 /// One thread: the claim is about checkpoints, and rayon's adaptive splitting may reorder float
 /// reductions between runs on a loaded machine.
@@ -25,20 +25,7 @@ fn data() -> &'static Path {
     static DATA: OnceLock<PathBuf> = OnceLock::new();
     DATA.get_or_init(|| {
         let data = scratch("train-resume-data").join("subject");
-        let args = [
-            "synth",
-            "--no-self-collision",
-            "--seed",
-            "3",
-            "--size",
-            "64",
-            "--supersample",
-            "1",
-            "--frames",
-            "10",
-        ];
-        let more = ["--train", "8", "--body", "default-lod1", "--out", s(&data)];
-        ok(command(&[&args[..], &more[..]].concat()).output().unwrap());
+        ok(command(&tiny_subject("3", &data)).output().unwrap());
         data
     })
 }

@@ -19,6 +19,35 @@ pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `mannequin synth` arguments of a tiny subject at `out` (64 px, 10 frames of which 8 train,
+/// the decimated body), simulated without cloth–cloth contacts: the tests that take it are not
+/// about the cloth.
+pub fn tiny_subject<'a>(seed: &'a str, out: &'a Path) -> [&'a str; 16] {
+    sized_subject(seed, "64", "1", out)
+}
+
+/// [`tiny_subject`] at `size` pixels, rendered at `supersample` times that.
+pub fn sized_subject<'a>(seed: &'a str, size: &'a str, supersample: &'a str, out: &'a Path) -> [&'a str; 16] {
+    [
+        "synth",
+        "--no-self-collision",
+        "--seed",
+        seed,
+        "--size",
+        size,
+        "--supersample",
+        supersample,
+        "--frames",
+        "10",
+        "--train",
+        "8",
+        "--body",
+        "default-lod1",
+        "--out",
+        s(out),
+    ]
+}
+
 /// Scratch folder `name` under the test target's temporary folder, emptied.
 pub fn scratch(name: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
@@ -53,22 +82,7 @@ pub fn usage_error(o: &Output, needles: &[&str]) {
 /// it for three iterations (`dir/model`): a few seconds.
 pub fn tiny_avatar(dir: &Path) -> (PathBuf, PathBuf) {
     let (data, model) = (dir.join("data"), dir.join("model"));
-    ok(mannequin(&[
-        "synth",
-        "--no-self-collision",
-        "--seed",
-        "1",
-        "--size",
-        "96",
-        "--frames",
-        "10",
-        "--train",
-        "8",
-        "--body",
-        "default-lod1",
-        "--out",
-        s(&data),
-    ]));
+    ok(mannequin(&sized_subject("1", "96", "2", &data)));
     ok(mannequin(&[
         "train",
         "--data",
