@@ -120,7 +120,7 @@ fn main() {
         // The launches do not depend on the cloth: the faster simulation.
         self_collision: false,
     };
-    generate(&model, &data, &options, &|| {}).expect("synth");
+    generate(&model, &data, &options, &|_| {}).expect("synth");
     let dataset = Dataset::open(&data, 1).expect("dataset");
     let split = dataset.split("train").expect("split");
     let views = load_views(&dataset, &split, |_, _| {}).expect("views");

@@ -152,7 +152,7 @@ fn main() {
         let dir = dir.join(format!("seed-{subject}"));
         let data = dir.join("subject");
         let options = SynthOptions { seed: subject, ..SynthOptions::default() };
-        let summary = generate(&model, &data, &options, &|| {}).expect("synth");
+        let summary = generate(&model, &data, &options, &|_| {}).expect("synth");
         println!("subject: synth seed {subject} ({:?}), {iters} iterations", summary.subject.outfit);
         let dataset = Dataset::open(&data, 1).expect("dataset");
         let split = dataset.split("train").expect("split");

@@ -29,7 +29,7 @@ fn subject(seed: u64, expected: Outfit) -> (PathBuf, Dataset, Split, Vec<View>) 
         // Training, not cloth, is under test: the faster simulation without cloth–cloth contacts.
         self_collision: false,
     };
-    let summary = generate(&BodyModel::default_body(), &dir, &options, &|| {}).expect("synthetic subject");
+    let summary = generate(&BodyModel::default_body(), &dir, &options, &|_| {}).expect("synthetic subject");
     assert_eq!(summary.subject.outfit, expected, "seed {seed}'s outfit changed; pick another seed");
     let dataset = Dataset::open(&dir, 1).unwrap();
     let split = dataset.split("train").unwrap();

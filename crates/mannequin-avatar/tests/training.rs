@@ -27,7 +27,7 @@ fn subject(name: &str) -> PathBuf {
         // Training, not cloth, is under test: the faster simulation without cloth–cloth contacts.
         self_collision: false,
     };
-    generate(&BodyModel::default_body_lod1(), &dir, &options, &|| {}).expect("synthetic subject");
+    generate(&BodyModel::default_body_lod1(), &dir, &options, &|_| {}).expect("synthetic subject");
     dir
 }
 

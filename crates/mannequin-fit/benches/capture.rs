@@ -59,7 +59,7 @@ fn main() {
     for subject in seed..seed + subjects {
         let data = dir.join(format!("seed-{subject}"));
         let summary =
-            generate(&model, &data, &SynthOptions { seed: subject, ..SynthOptions::default() }, &|| {})
+            generate(&model, &data, &SynthOptions { seed: subject, ..SynthOptions::default() }, &|_| {})
                 .expect("synth");
         let dataset = Dataset::open(&data, 1).expect("dataset");
         let truth = all_poses(&dataset);

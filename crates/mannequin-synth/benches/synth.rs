@@ -29,8 +29,8 @@ fn main() {
     };
     let frames = short.total_frames() as f64;
     let s1 =
-        single.install(|| time_once(|| generate(&model, &dir, &short, &|| {}).expect("synthetic subject")));
-    let sn = time_once(|| generate(&model, &dir, &short, &|| {}).expect("synthetic subject"));
+        single.install(|| time_once(|| generate(&model, &dir, &short, &|_| {}).expect("synthetic subject")));
+    let sn = time_once(|| generate(&model, &dir, &short, &|_| {}).expect("synthetic subject"));
     println!(
         "synth, {} frames: 1 thread {:.1} frames/s; {threads} threads {:.1} frames/s ({:.1}×)",
         frames,
@@ -41,9 +41,9 @@ fn main() {
     // The default subject with the cloth–cloth contacts (the default) and without: the issue's
     // target is 60 s with them.
     let full = SynthOptions::default();
-    let with = time_once(|| generate(&model, &dir, &full, &|| {}).expect("synthetic subject"));
+    let with = time_once(|| generate(&model, &dir, &full, &|_| {}).expect("synthetic subject"));
     let plain = SynthOptions { self_collision: false, ..full.clone() };
-    let without = time_once(|| generate(&model, &dir, &plain, &|| {}).expect("synthetic subject"));
+    let without = time_once(|| generate(&model, &dir, &plain, &|_| {}).expect("synthetic subject"));
     let size = full.size;
     println!(
         "synth default ({} frames at {size}²): {with:.1} s with cloth–cloth contacts (target 60 s), \

@@ -8,11 +8,13 @@
 pub mod error;
 pub mod motion;
 pub mod scene;
+pub mod step;
 pub mod subject;
 pub mod texture;
 pub mod wardrobe;
 
 pub use error::SynthError;
+pub use step::Step;
 
 use std::path::Path;
 
@@ -30,6 +32,14 @@ use subject::Subject;
 
 /// The capture's frame rate: 120 frames turn the subject 1.25 times in 4 s.
 const CAPTURE_FPS: f32 = 30.0;
+/// The capture's turns.
+const CAPTURE_TURNS: f32 = 1.25;
+/// The most the subject turns between two poses the cloth simulator sees, in degrees, one
+/// [`CAPTURE_FPS`] frame apart: the body moves linearly between them, cutting the corner of its
+/// turn by 1 − cos(θ/2) of its radius (2 % here, 21 % at the 75° of a 6-frame capture, where the
+/// shrunken body leaves the cloth inside it when it widens again), and a faster turn flings
+/// the cloth through itself. A sparser capture is slower, with poses blended between its frames.
+const MAX_TURN_PER_POSE: f32 = 22.5;
 /// Poses the cloth simulator sees per frame of the out-of-distribution motions (about 30 fps).
 const NOVEL_SUBFRAMES: usize = 4;
 /// What `origin.json` names as the dataset's writer.
@@ -73,7 +83,7 @@ impl Default for SynthOptions {
 }
 
 impl SynthOptions {
-    /// Frames written in all, for progress display.
+    /// Frames written in all.
     pub fn total_frames(&self) -> usize {
         self.capture_frames + self.view_poses * scene::NOVEL_VIEWS + 4 * self.motion_frames
     }
@@ -132,7 +142,7 @@ fn write_frames(
     cameras: &[Camera],
     writer: &DatasetWriter,
     supersample: usize,
-    on_frame: &(dyn Fn() + Sync),
+    on_step: &(dyn Fn(Step) + Sync),
 ) -> Result<(), SynthError> {
     (0..seq.len()).into_par_iter().try_for_each(|i| {
         let mesh = seq.mesh(scene, i);
@@ -149,20 +159,22 @@ fn write_frames(
         for (name, garment) in seq.garment_meshes(scene, i) {
             writer.write_garment_mesh(i, name, &garment)?;
         }
-        on_frame();
+        on_step(Step::Written);
         Ok(())
     })
 }
 
 /// Generates the dataset under `out`: the capture at the root, `test/novel_view/` and
-/// `test/novel_pose/` beside it. Deterministic in `options`.
+/// `test/novel_pose/` beside it, reporting each frame simulated and written to `on_step`.
+/// Deterministic in `options`.
 pub fn generate(
     model: &BodyModel,
     out: &Path,
     options: &SynthOptions,
-    on_frame: &(dyn Fn() + Sync),
+    on_step: &(dyn Fn(Step) + Sync),
 ) -> Result<SynthSummary, SynthError> {
     options.check()?;
+    on_step(Step::Planned(options.total_frames()));
     let subject = Subject::random(options.seed, model.num_betas().min(10));
     let scene = Scene::new(model, &subject)?;
     let mut rng =
@@ -170,21 +182,24 @@ pub fn generate(
 
     // The capture: one camera, the subject turning. The camera also frames the novel poses,
     // which are seen from it too.
-    let capture_poses = motion::turning_a_pose(options.capture_frames, 1.25, &mut rng)?;
+    let capture_poses = motion::turning_a_pose(options.capture_frames, CAPTURE_TURNS, &mut rng)?;
+    let turn = 360.0 * CAPTURE_TURNS / options.capture_frames as f32;
+    let capture_subframes = (turn / MAX_TURN_PER_POSE).ceil() as usize;
     let (motion_names, novel_poses) = motion::novel_poses(options.motion_frames, &mut rng)?;
     // The capture and each motion simulated apart, side by side (much of the cloth solver
     // runs on one core), each motion from rest: one after another they would jump between motions.
     let contacts = options.self_collision;
-    let clips: Vec<(&[f32], f32, usize)> = std::iter::once((&capture_poses[..], CAPTURE_FPS, 1))
-        .chain(
-            novel_poses
-                .chunks(72 * options.motion_frames)
-                .map(|clip| (clip, motion::novel_pose_fps(options.motion_frames), NOVEL_SUBFRAMES)),
-        )
-        .collect();
+    let clips: Vec<(&[f32], f32, usize)> =
+        std::iter::once((&capture_poses[..], CAPTURE_FPS / capture_subframes as f32, capture_subframes))
+            .chain(
+                novel_poses
+                    .chunks(72 * options.motion_frames)
+                    .map(|clip| (clip, motion::novel_pose_fps(options.motion_frames), NOVEL_SUBFRAMES)),
+            )
+            .collect();
     let mut played = clips
         .into_par_iter()
-        .map(|(poses, fps, subframes)| scene.pose(model, poses, fps, subframes, contacts))
+        .map(|(poses, fps, subframes)| scene.pose(model, (poses, fps, subframes), contacts, on_step))
         .collect::<Result<Vec<_>, _>>()?
         .into_iter();
     let capture = played.next().expect("the capture is the first sequence");
@@ -216,7 +231,7 @@ pub fn generate(
         &vec![camera.clone(); capture.len()],
         &root,
         options.supersample,
-        on_frame,
+        on_step,
     )?;
 
     // Novel views: evenly spaced training poses from each of the novel cameras.
@@ -237,7 +252,7 @@ pub fn generate(
     nv.write_splits(&one_split("test", views.len()))?;
     nv.write_origin(PoseOrigin::Truth, SYNTHESISED_BY)?;
     nv.write_poses("test", &split_poses(&subject.betas, &view_poses, &views.transl))?;
-    write_frames(&scene, &views, &view_cameras, &nv, options.supersample, on_frame)?;
+    write_frames(&scene, &views, &view_cameras, &nv, options.supersample, on_step)?;
 
     // Novel poses: out-of-distribution motions from the training camera.
     let np = DatasetWriter::new(out.join("test/novel_pose"));
@@ -245,7 +260,7 @@ pub fn generate(
     np.write_splits(&one_split("test", novel.len()))?;
     np.write_origin(PoseOrigin::Truth, SYNTHESISED_BY)?;
     np.write_poses("test", &split_poses(&subject.betas, &novel_poses, &novel.transl))?;
-    write_frames(&scene, &novel, &vec![camera; novel.len()], &np, options.supersample, on_frame)?;
+    write_frames(&scene, &novel, &vec![camera; novel.len()], &np, options.supersample, on_step)?;
 
     scene.texture.write_png(&out.join("texture.png"))?;
     let mut motions: Vec<&'static str> = motion_names;

@@ -10,6 +10,7 @@ use mannequin_mesh::normals::vertex_normals;
 use mannequin_mesh::{TriMesh, UvLayout, points};
 
 use crate::error::SynthError;
+use crate::step::Step;
 use crate::subject::Subject;
 use crate::texture::{BakeInput, SurfacePoint, bake, smoothstep};
 use crate::wardrobe::{Piece, Worn, dress_subject, triangle_atlas};
@@ -261,14 +262,13 @@ impl Scene {
     /// rest, after settling into the first frame. The simulator sees `subframes` poses per frame,
     /// blended between the frames: its body moves linearly between the poses it is given, which
     /// for a swinging limb far apart cuts the corner through the cloth. `self_collision` turns
-    /// the cloth–cloth contacts on.
+    /// the cloth–cloth contacts on; each garment's simulated frames are reported to `on_step`.
     pub fn pose(
         &self,
         model: &BodyModel,
-        poses: &[f32],
-        fps: f32,
-        subframes: usize,
+        (poses, fps, subframes): (&[f32], f32, usize),
         self_collision: bool,
+        on_step: &(dyn Fn(Step) + Sync),
     ) -> Result<PosedSequence, SynthError> {
         let frames = poses.len() / 72;
         let dense: Vec<f32> = (0..frames)
@@ -281,7 +281,7 @@ impl Scene {
                 })
             })
             .collect();
-        let played = self.play(model, &dense, fps * subframes as f32, self_collision)?;
+        let played = self.play(model, &dense, fps * subframes as f32, self_collision, on_step)?;
         Ok(played.select(&(0..frames).map(|f| f * subframes).collect::<Vec<_>>()))
     }
 
@@ -291,6 +291,7 @@ impl Scene {
         poses: &[f32],
         fps: f32,
         self_collision: bool,
+        on_step: &(dyn Fn(Step) + Sync),
     ) -> Result<PosedSequence, SynthError> {
         let frames = poses.len() / 72;
         let still = pose_frames(model, &self.shaped, poses, &vec![0.0; 3 * frames])?;
@@ -310,6 +311,8 @@ impl Scene {
             gender: None,
         };
         let schedule = Settling::new(model, &motion, mannequin_cloth::SETTLE_SECONDS)?;
+        // Each garment's first frame is its rest shape.
+        on_step(Step::Planned(self.worn.len() * (schedule.len() - 1)));
         let body_frames = schedule.body_frames(model, &self.shaped)?;
         let fail = |e: GarmentError| SynthError::Invalid(format!("dressing the subject: {e}"));
         let dressed: Vec<Dressed> = self
@@ -322,9 +325,11 @@ impl Scene {
         let wearer = Wearer { faces: &self.body_faces, frames: &body_frames, schedule: &schedule, fps };
         let settings =
             Settings { substeps: Settings::substeps_at(fps), self_collision, ..Settings::default() };
-        let layers =
-            wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |_| Ok(()))
-                .map_err(fail)?;
+        let layers = wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |_| {
+            on_step(Step::Simulated);
+            Ok(())
+        })
+        .map_err(fail)?;
         let vertices = (schedule.settle..schedule.len())
             .map(|k| {
                 let mut all = body_frames[k].clone();

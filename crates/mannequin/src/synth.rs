@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use mannequin_body::BodyModel;
-use mannequin_synth::{SynthOptions, generate};
+use mannequin_synth::{Step, SynthOptions, generate};
 
 use mannequin_io::progress::{JobTimer, bar};
 
@@ -24,7 +24,8 @@ pub struct Args {
     /// Render at this multiple of the size and box-filter down (anti-aliasing).
     #[arg(long, default_value_t = SynthOptions::default().supersample)]
     supersample: usize,
-    /// Frames of the turning capture.
+    /// Frames of the turning capture, 1/30 s apart (fewer than 20 are further apart: the
+    /// subject turns at most 22.5° in 1/30 s, for the cloth to follow).
     #[arg(long, default_value_t = SynthOptions::default().capture_frames)]
     frames: usize,
     /// Of those, the first N form the training split; the rest are the test split.
@@ -45,11 +46,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         supersample: args.supersample,
         capture_frames: args.frames,
         train_frames: args.train,
+        // Novel views re-render training poses: no more than there are.
+        view_poses: SynthOptions::default().view_poses.min(args.train),
         self_collision: !args.no_self_collision,
         ..SynthOptions::default()
     };
-    let progress = bar(options.total_frames() as u64, "synth");
-    let summary = generate(&model, &args.out, &options, &|| progress.inc(1))?;
+    // Simulated cloth frames and written frames, the length growing as each part is planned.
+    let progress = bar(0, "synth");
+    let summary = generate(&model, &args.out, &options, &|step| match step {
+        Step::Planned(steps) => progress.inc_length(steps as u64),
+        Step::Simulated | Step::Written => progress.inc(1),
+    })?;
     progress.finish_and_clear();
     tracing::info!(
         "wrote {} ({:?}, {} vertices): {} capture frames, {} novel-view and {} novel-pose frames",
