@@ -24,7 +24,8 @@ pub struct Args {
     /// Render at this multiple of the size and box-filter down (anti-aliasing).
     #[arg(long, default_value_t = SynthOptions::default().supersample)]
     supersample: usize,
-    /// Frames of the turning capture.
+    /// Frames of the turning capture, 1/30 s apart (fewer than 60 are further apart: the
+    /// subject turns at most 7.5° in 1/30 s, for the cloth to follow).
     #[arg(long, default_value_t = SynthOptions::default().capture_frames)]
     frames: usize,
     /// Of those, the first N form the training split; the rest are the test split.
