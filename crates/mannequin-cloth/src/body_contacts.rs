@@ -1,6 +1,7 @@
-//! Body collision: the body interpolated linearly across the substeps of a frame, and every free
-//! particle pushed out to `margin` from its surface, with Coulomb friction against the body's own
-//! motion there (the position-level friction of Macklin et al. 2014, "Unified particle physics").
+//! Body collision: the body interpolated linearly across the substeps of a frame (as many as keep
+//! its every vertex within a margin a substep), and every free particle pushed out to `margin`
+//! from its surface, with Coulomb friction against the body's own motion there (the
+//! position-level friction of Macklin et al. 2014, "Unified particle physics").
 //!
 //! Candidate triangles come from a hash of each triangle's box swept over a window of substeps:
 //! the body's motion is known for the whole frame, so the swept box holds the triangle at every
@@ -18,6 +19,16 @@ use mannequin_mesh::barycentric::{at_barycentric, closest_barycentric};
 /// in it, so the swept boxes stay about a cell in size.
 const WINDOW_TRAVEL: f32 = 0.5;
 
+/// The farthest a body vertex may move in one substep, in body margins: a body that moves farther
+/// pushes a particle deeper than the margin it keeps in one go, and the cloth contacts, which have
+/// the last word, can then hold it inside. A frame where the body moves faster takes more substeps.
+const MAX_STEP_IN_MARGINS: f32 = 1.0;
+
+/// The most substeps a fast frame takes, as a multiple of the settings' count: a body turning
+/// 75° in 1/30 s asks for 10 times as many; past this, a frame where the body jumps (a cut in
+/// the motion) would cost minutes.
+const MAX_SUBSTEP_FACTOR: u32 = 16;
+
 #[derive(Debug, Clone)]
 pub(crate) struct BodyCollider {
     pub body: Body,
@@ -31,8 +42,6 @@ pub(crate) struct BodyCollider {
     boxes: Vec<Aabb>,
     hash: BoxHash,
     substeps: u32,
-    /// The farthest any body vertex moves in one substep of this frame.
-    pub step: f32,
     /// Substeps per hash window, and the substep where the current window ends.
     window: u32,
     window_end: u32,
@@ -54,7 +63,6 @@ impl BodyCollider {
             boxes: Vec::new(),
             hash: BoxHash::default(),
             substeps: 1,
-            step: 0.0,
             window: 1,
             window_end: 0,
             cell: 1.0,
@@ -62,14 +70,16 @@ impl BodyCollider {
         }
     }
 
-    /// Takes the body's vertices at the start and the end of the frame.
+    /// Takes the body's vertices at the start and the end of the frame, and returns the substeps
+    /// the frame takes: at least `substeps`, and enough that no body vertex moves farther than
+    /// [`MAX_STEP_IN_MARGINS`] margins in one (up to [`MAX_SUBSTEP_FACTOR`] times `substeps`).
     pub fn begin_frame(
         &mut self,
         start: &[[f32; 3]],
         end: &[[f32; 3]],
         substeps: u32,
         margin: f32,
-    ) -> Result<(), ClothError> {
+    ) -> Result<u32, ClothError> {
         for (field, values) in [("body_start", start), ("body_end", end)] {
             if values.len() < self.body.vertices_needed || values.len() != start.len() {
                 let reason = format!(
@@ -87,10 +97,11 @@ impl BodyCollider {
         self.start.extend(start.iter().map(|&p| Vec3::from(p)));
         self.end.clear();
         self.end.extend(end.iter().map(|&p| Vec3::from(p)));
-        self.substeps = substeps;
         let travel = self.start.iter().zip(&self.end).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
+        let needed = (travel / (MAX_STEP_IN_MARGINS * margin)).ceil() as u32;
+        let substeps = needed.clamp(substeps, MAX_SUBSTEP_FACTOR * substeps);
+        self.substeps = substeps;
         let step = travel / substeps as f32;
-        self.step = step;
         self.reach = margin + 2.0 * step;
         let extents: f32 = self
             .body
@@ -106,7 +117,7 @@ impl BodyCollider {
         };
         self.window_end = 0;
         self.now.clone_from(&self.start);
-        Ok(())
+        Ok(substeps)
     }
 
     /// Moves the body to the end of substep `k`; the positions at its start become `before`.

@@ -14,7 +14,8 @@ pub const SUBSTEPS_TUNED_FPS: f32 = 30.0;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
-    /// Substeps per frame; each substep predicts, projects and updates velocities.
+    /// Substeps per frame, at the least (a frame where the body moves fast takes more); each
+    /// substep predicts, projects and updates velocities.
     pub substeps: u32,
     /// Constraint passes per substep. Small steps want one; more passes reuse the multipliers λ.
     pub iterations: u32,

@@ -117,17 +117,18 @@ impl Simulator {
         if !(frame_dt.is_finite() && frame_dt > 0.0) {
             return Err(ClothError::invalid("frame_dt", format!("{frame_dt} is not a positive duration")));
         }
-        let substeps = self.settings.substeps;
-        match &mut self.body {
-            Some(body) => body.begin_frame(body_start, body_end, substeps, self.settings.body_margin)?,
-            None if body_start.is_empty() && body_end.is_empty() => {}
+        let substeps = match &mut self.body {
+            Some(body) => {
+                body.begin_frame(body_start, body_end, self.settings.substeps, self.settings.body_margin)?
+            }
+            None if body_start.is_empty() && body_end.is_empty() => self.settings.substeps,
             None => {
                 return Err(ClothError::invalid(
                     "body_start",
                     "body positions given, but the simulator has no body",
                 ));
             }
-        }
+        };
         if let Some(layers) = &self.layers {
             // Where the caller says, moving at the frame's pace: a resumed run starts as this one.
             let (n, first) = (self.cloth.particle_count(), layers.first_vertex);

@@ -12,7 +12,8 @@ pub const SETTLE_SECONDS: f32 = 1.0;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, clap::Args)]
 pub struct Stepping {
-    /// Simulation substeps per output frame (one constraint iteration each), at most 100.
+    /// Simulation substeps per output frame (one constraint iteration each), at most 100; a
+    /// frame where the body moves fast takes more.
     #[arg(
         long = "substeps",
         default_value_t = Stepping::default().substeps,
