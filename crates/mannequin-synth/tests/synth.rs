@@ -159,19 +159,16 @@ fn synthetic_subject_is_a_consistent_dataset() {
     // the capture's first frame. The squat and the crossed arms push the body through itself
     // (thigh into calf, arm into chest: 123–133 pairs at their last frame), and cloth caught
     // between can be outside neither: there the pants had 452 vertices inside the body.
-    let body_crossings = |mesh: &mannequin_mesh::TriMesh| {
-        let n = model.num_vertices();
-        let faces: Vec<[u32; 3]> =
-            mesh.faces.iter().copied().filter(|t| t.iter().all(|&i| (i as usize) < n)).collect();
-        self_intersecting_pairs(&mesh.positions[..n], &faces)
-    };
+    let n = model.num_vertices();
+    let body_crossings =
+        |mesh: &mannequin_mesh::TriMesh| self_intersecting_pairs(&mesh.positions[..n], &body_faces(mesh, n));
     let at_capture = body_crossings(&ds.mesh(0).unwrap().unwrap().mesh);
     let novel = Dataset::open(root.join("test/novel_pose"), 1).unwrap();
     let mut checked = 0;
     for f in 0..novel.frame_count {
         let mesh = novel.mesh(f).unwrap().unwrap().mesh;
         if body_crossings(&mesh) <= at_capture {
-            check_layers(&root.join("test/novel_pose"), f, &mesh, model.num_vertices(), garments);
+            check_layers(&root.join("test/novel_pose"), f, &mesh, n, garments);
             checked += 1;
         }
     }
@@ -180,13 +177,17 @@ fn synthetic_subject_is_a_consistent_dataset() {
     std::fs::remove_dir_all(root).unwrap();
 }
 
+/// The faces of `mesh` among its first `body` vertices: the body's, which come first.
+fn body_faces(mesh: &mannequin_mesh::TriMesh, body: usize) -> Vec<[u32; 3]> {
+    mesh.faces.iter().copied().filter(|t| t.iter().all(|&i| (i as usize) < body)).collect()
+}
+
 /// Checks frame `f`'s garment meshes under `root`: each is its part of the whole `mesh`, after
 /// the body (its first `body` vertices) and the layers under it, and they are all the rest of it;
 /// (almost) none of it is inside the body, and none crosses itself or the layers under it.
 fn check_layers(root: &Path, f: usize, mesh: &mannequin_mesh::TriMesh, body: usize, garments: &[&str]) {
     let mut start = body;
-    let body_faces: Vec<[u32; 3]> =
-        mesh.faces.iter().copied().filter(|t| t.iter().all(|&i| (i as usize) < start)).collect();
+    let body_faces = body_faces(mesh, body);
     let mut inner: Vec<mannequin_mesh::TriMesh> = Vec::new();
     for name in garments {
         let path = root.join(format!("meshes/garment_{name}_{f:04}.ply"));
