@@ -30,12 +30,18 @@ pub fn named_pose(name: &str) -> Result<[f32; 72], BodyError> {
             set(&mut p, R_SHOULDER, [0.0, 0.0, -(FRAC_PI_2 - 0.3)]);
         }
         "squat" => {
-            set(&mut p, L_HIP, [-1.7, 0.0, -0.15]);
-            set(&mut p, R_HIP, [-1.7, 0.0, 0.15]);
-            set(&mut p, L_KNEE, [2.0, 0.0, 0.0]);
-            set(&mut p, R_KNEE, [2.0, 0.0, 0.0]);
-            set(&mut p, L_ANKLE, [-0.3, 0.0, 0.0]);
-            set(&mut p, R_ANKLE, [-0.3, 0.0, 0.0]);
+            // Thighs flexed and turned out (a negative turn about +Y swings the flexed left
+            // thigh to +X), knees bent to 80°: as deep as the body's skinning allows. Feet
+            // together and knees past 90°, as before, the thighs sank into the belly and the
+            // calves (123–156 crossing triangle pairs on the synthetic subjects); here only the
+            // creases behind the knees and in the groin fold into themselves (17–27, the
+            // arms' reach included).
+            set(&mut p, L_HIP, [-1.2, 0.5, 0.0]);
+            set(&mut p, R_HIP, [-1.2, -0.5, 0.0]);
+            set(&mut p, L_KNEE, [1.4, 0.0, 0.0]);
+            set(&mut p, R_KNEE, [1.4, 0.0, 0.0]);
+            set(&mut p, L_ANKLE, [-0.25, 0.0, 0.0]);
+            set(&mut p, R_ANKLE, [-0.25, 0.0, 0.0]);
             // Arms reach forward for balance: a negative turn about +Y swings the left arm to +Z.
             set(&mut p, L_SHOULDER, [0.0, -1.2, -0.3]);
             set(&mut p, R_SHOULDER, [0.0, 1.2, 0.3]);
@@ -51,10 +57,12 @@ pub fn named_pose(name: &str) -> Result<[f32; 72], BodyError> {
             set(&mut p, L_ELBOW, [0.0, 0.0, 0.0]);
         }
         "arms-crossed" => {
-            set(&mut p, L_SHOULDER, [0.0, -1.1, -0.5]);
-            set(&mut p, R_SHOULDER, [0.0, 1.1, 0.5]);
-            set(&mut p, L_ELBOW, [0.0, -1.6, 0.0]);
-            set(&mut p, R_ELBOW, [0.0, 1.6, 0.0]);
+            // The left forearm crosses above and in front of the right one. Mirrored, the two
+            // forearms met at one height and passed through each other (99–155 crossing pairs).
+            set(&mut p, L_SHOULDER, [0.0, -1.45, -0.45]);
+            set(&mut p, R_SHOULDER, [0.0, 0.85, 0.55]);
+            set(&mut p, L_ELBOW, [0.0, -1.5, 0.0]);
+            set(&mut p, R_ELBOW, [0.0, 1.5, 0.0]);
         }
         other => {
             return Err(BodyError::input(

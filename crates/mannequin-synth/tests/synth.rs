@@ -155,10 +155,11 @@ fn synthetic_subject_is_a_consistent_dataset() {
         assert!(mesh.positions.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min).abs() < 1e-4);
     }
     assert!(seen.iter().all(|&s| s), "every garment shows in some training frame: {garments:?} {seen:?}");
-    // The novel poses' cloth holds as well, where the body does not cross itself more than in
-    // the capture's first frame. The squat and the crossed arms push the body through itself
-    // (thigh into calf, arm into chest: 123–133 pairs at their last frame), and cloth caught
-    // between can be outside neither: there the pants had 452 vertices inside the body.
+    // The novel poses' cloth holds as well, where the body crosses itself at most as the arm
+    // poses do (4 pairs more than in the capture's first frame: the shoulders' creases). Deep in
+    // the squat the creases behind the knees and in the groin fold into themselves (8–17 pairs
+    // for this subject), and cloth caught in them can be outside neither side: there the pants
+    // have 15–27 of 3,822 vertices inside the body and one pair crossing.
     let n = model.num_vertices();
     let body_crossings =
         |mesh: &mannequin_mesh::TriMesh| self_intersecting_pairs(&mesh.positions[..n], &body_faces(mesh, n));
@@ -167,13 +168,13 @@ fn synthetic_subject_is_a_consistent_dataset() {
     let mut checked = 0;
     for f in 0..novel.frame_count {
         let mesh = novel.mesh(f).unwrap().unwrap().mesh;
-        if body_crossings(&mesh) <= at_capture {
+        if body_crossings(&mesh) <= at_capture + 4 {
             check_layers(&root.join("test/novel_pose"), f, &mesh, n, garments);
             checked += 1;
         }
     }
-    // The walk's and the raised arms' frames, at least.
-    assert!(checked >= 4, "{checked} novel-pose frames checked");
+    // The walk's, the raised arms' and the crossed arms' frames.
+    assert!(checked >= 6, "{checked} novel-pose frames checked");
     std::fs::remove_dir_all(root).unwrap();
 }
 
