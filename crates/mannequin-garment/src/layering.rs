@@ -98,7 +98,7 @@ impl Garment {
             let mut pushed = false;
             for (point, d) in points.iter().zip(&mut offsets) {
                 let p = *point + Vec3::from(*d);
-                let Some((on, q)) = surface.query(p) else { break };
+                let Some((on, q)) = surface.query_within(p, CLEARING_REACH * gap) else { continue };
                 let (n, apart) = (normals[on.face as usize], p - q);
                 let clearance = apart.dot(n);
                 if clearance < gap && apart.length() < CLEARING_REACH * gap {

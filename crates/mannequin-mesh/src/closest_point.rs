@@ -62,23 +62,37 @@ impl ClosestPoint {
     /// The closest point of the mesh to `p`, searching shells of cells outwards until no
     /// unsearched cell can hold anything closer; `None` for a mesh without faces.
     pub fn query(&self, p: Vec3) -> Option<(SurfacePoint, Vec3)> {
-        if self.faces.is_empty() {
-            return None;
+        // Past this many shells, fall back to all faces, unless the search has already found
+        // something nearer than any cell it left out can hold.
+        let shells: i32 = 64;
+        match self.search(p, shells) {
+            Some((d, s, q)) if d < ((shells - 1) as f32 * self.cell).powi(2) => Some((s, q)),
+            _ => self.brute_force(p),
         }
+    }
+
+    /// The closest point of the mesh to `p` if it is within `radius`: only the cells that
+    /// distance reaches are searched, so a point far from the surface costs no more than one
+    /// near it (a shell of cells `s` away holds (2s + 1)³ − (2s − 1)³ of them).
+    pub fn query_within(&self, p: Vec3, radius: f32) -> Option<(SurfacePoint, Vec3)> {
+        // A point r away lies in a cell at most ⌊r / cell⌋ + 1 shells out.
+        let shells = (radius / self.cell).floor() as i32 + 2;
+        self.search(p, shells).filter(|(d, ..)| *d <= radius * radius).map(|(_, s, q)| (s, q))
+    }
+
+    /// The nearest point of the faces in the first `shells` shells of cells around `p` (its
+    /// squared distance, where, and the point), stopping early once no unsearched cell can
+    /// hold anything closer.
+    fn search(&self, p: Vec3, shells: i32) -> Option<(f32, SurfacePoint, Vec3)> {
         let centre = key(p, self.cell);
         let mut best: Option<(f32, SurfacePoint, Vec3)> = None;
         let mut seen = std::collections::HashSet::new();
-        // Past this many shells every cell has been looked at: fall back to all faces.
-        let max_shell: i32 = 64;
-        for shell in 0..=max_shell {
+        for shell in 0..shells {
             // A point in a cell `shell` away is at least (shell − 1) cells from p.
             if let Some((d, ..)) = best
                 && d < ((shell as f32 - 1.0).max(0.0) * self.cell).powi(2)
             {
                 break;
-            }
-            if shell == max_shell {
-                return self.brute_force(p);
             }
             for x in -shell..=shell {
                 for y in -shell..=shell {
@@ -103,7 +117,7 @@ impl ClosestPoint {
                 }
             }
         }
-        best.map(|(_, s, q)| (s, q))
+        best
     }
 
     fn on_face(&self, f: u32, p: Vec3) -> (f32, SurfacePoint, Vec3) {
@@ -160,6 +174,13 @@ mod tests {
             let (_, q_all) = index.brute_force(p).unwrap();
             assert!((q.distance(p) - q_all.distance(p)).abs() < 1e-6, "{p}: {q} vs {q_all}");
             assert!(s.locate(&positions, &faces).distance(q) < 1e-6);
+            // Within a radius: the same point where the scan's is that near, nothing where not.
+            let radius = 0.01 + 0.1 * next();
+            let near = index.query_within(p, radius);
+            match q_all.distance(p) <= radius {
+                true => assert!((near.unwrap().1.distance(p) - q_all.distance(p)).abs() < 1e-6, "{p}"),
+                false => assert!(near.is_none(), "{p}: {near:?} beyond {radius}"),
+            }
         }
     }
 }
