@@ -6,6 +6,11 @@
 //! Each node holds a box around its elements' places and one around their velocities, so the walk
 //! can ask whether two nodes meet within a time: cloth moving together has a narrow box of
 //! velocity differences and stays apart however fast it travels.
+//!
+//! Elements of the layers under the cloth meet only the cloth's: their leaves come after all of
+//! the cloth's, so whole subtrees of them are passed over together when walked against each
+//! other (a T-shirt's walk otherwise went down to every pair of neighbouring triangles of the
+//! pants under it, to throw them all away).
 
 use glam::Vec3;
 
@@ -53,6 +58,8 @@ pub(crate) struct BoxTree {
     /// A complete binary tree: node i has children 2i and 2i + 1, the leaves are nodes
     /// `leaves..2 · leaves`, and node 0 is unused.
     nodes: Vec<MovingBox>,
+    /// Per node, whether any element under it is the cloth's.
+    cloth: Vec<bool>,
     leaves: usize,
 }
 
@@ -83,8 +90,9 @@ impl BoxTree {
     }
 
     /// Orders the leaves along a Morton curve through `boxes`, one per element: a cloth's start
-    /// shape, so that a run resumed from a checkpoint walks its pairs in the same order.
-    pub fn order_leaves(&mut self, boxes: &[Aabb]) {
+    /// shape, so that a run resumed from a checkpoint walks its pairs in the same order. The
+    /// elements `cloth` says are the cloth's come first, those of the layers under it after.
+    pub fn order_leaves(&mut self, boxes: &[Aabb], cloth: &[bool]) {
         let centre = |b: &Aabb| 0.5 * (b.min + b.max);
         let all = boxes.iter().fold(NOTHING, |a, b| a.union(*b));
         let scale = 1023.0 / all.extent().max_element().max(f32::MIN_POSITIVE);
@@ -92,16 +100,24 @@ impl BoxTree {
             let q = ((centre(b) - all.min) * scale).as_uvec3();
             spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
         };
-        let mut keyed: Vec<(u32, u32)> = boxes.iter().enumerate().map(|(k, b)| (code(b), k as u32)).collect();
+        let mut keyed: Vec<(bool, u32, u32)> =
+            boxes.iter().enumerate().map(|(k, b)| (!cloth[k], code(b), k as u32)).collect();
         keyed.sort_unstable();
-        self.order = keyed.into_iter().map(|(_, k)| k).collect();
+        self.order = keyed.into_iter().map(|(_, _, k)| k).collect();
         self.leaves = boxes.len().next_power_of_two();
         self.nodes = vec![EMPTY; 2 * self.leaves];
+        self.cloth = vec![false; 2 * self.leaves];
+        for (k, &e) in self.order.iter().enumerate() {
+            self.cloth[self.leaves + k] = cloth[e as usize];
+        }
+        for i in (1..self.leaves).rev() {
+            self.cloth[i] = self.cloth[2 * i] || self.cloth[2 * i + 1];
+        }
     }
 
-    /// Every pair (a of `self`, b of `other`) whose boxes may come within `reach` within
-    /// `horizon` ([`MovingBox`]), once; with `other` the same tree, every unordered pair of two
-    /// elements once, as (a, b) or (b, a). Walks both trees together, so a pair of subtrees apart
+    /// Every pair (a of `self`, b of `other`), one of them the cloth's, whose boxes may come
+    /// within `reach` within `horizon` ([`MovingBox`]), once; with `other` the same tree, every
+    /// unordered pair of two elements once, as (a, b) or (b, a). Walks both trees together, so a pair of subtrees apart
     /// is passed over at once; the top of the walk runs in parallel.
     pub fn meeting_pairs(&self, other: &BoxTree, horizon: f32, reach: f32) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
@@ -144,7 +160,9 @@ struct Walk<'a> {
 impl Walk<'_> {
     fn visit(&self, (a, b): (usize, usize), out: &mut Vec<(u32, u32)>) {
         let (ours, theirs) = (self.ours, self.theirs);
-        if !ours.nodes[a].may_meet(&theirs.nodes[b], self.horizon, self.reach) {
+        if !(ours.cloth[a] || theirs.cloth[b])
+            || !ours.nodes[a].may_meet(&theirs.nodes[b], self.horizon, self.reach)
+        {
             return;
         }
         let split = |x: (usize, usize), y: (usize, usize), out: &mut Vec<(u32, u32)>| {
@@ -202,15 +220,18 @@ mod tests {
     }
 
     /// Against every pair tested directly, before and after the boxes move (the leaves keep
-    /// their first order): each overlapping pair of one tree once, and each across two trees.
+    /// their first order): each overlapping pair of one tree once, and each across two trees,
+    /// but those of two layer elements (every third of one tree, every fourth of the other).
     #[test]
     fn finds_exactly_the_overlapping_pairs_once() {
         let (mut tree, mut other) = (BoxTree::default(), BoxTree::default());
+        let cloth: Vec<bool> = (0..403).map(|k| k % 3 != 0).collect();
+        let others_cloth: Vec<bool> = (0..77).map(|k| k % 4 != 0).collect();
         for shift in [0.0, 1.3] {
             let (boxes, others) = (scattered(403, shift), scattered(77, shift + 0.4));
             if shift == 0.0 {
-                tree.order_leaves(&boxes);
-                other.order_leaves(&others);
+                tree.order_leaves(&boxes, &cloth);
+                other.order_leaves(&others, &others_cloth);
             }
             tree.refit(&boxes.iter().map(|&b| MovingBox::still(b)).collect::<Vec<_>>());
             other.refit(&others.iter().map(|&b| MovingBox::still(b)).collect::<Vec<_>>());
@@ -221,6 +242,7 @@ mod tests {
             let direct: Vec<(u32, u32)> = (0..n)
                 .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
                 .filter(|&(a, b)| boxes[a as usize].overlaps(&boxes[b as usize]))
+                .filter(|&(a, b)| cloth[a as usize] || cloth[b as usize])
                 .collect();
             assert_eq!(found, direct);
             let mut found = tree.meeting_pairs(&other, 0.0, 0.0);
@@ -229,13 +251,15 @@ mod tests {
             for (b, query) in others.iter().enumerate() {
                 let mut near = Vec::new();
                 tree.near(&MovingBox::still(*query), 0.0, &mut near);
-                queried.extend(near.into_iter().map(|a| (a, b as u32)));
+                let meets = |a: &u32| cloth[*a as usize] || others_cloth[b];
+                queried.extend(near.into_iter().filter(meets).map(|a| (a, b as u32)));
             }
             queried.sort_unstable();
             assert_eq!(queried, found);
             let direct: Vec<(u32, u32)> = (0..n)
                 .flat_map(|a| (0..others.len() as u32).map(move |b| (a, b)))
                 .filter(|&(a, b)| boxes[a as usize].overlaps(&others[b as usize]))
+                .filter(|&(a, b)| cloth[a as usize] || others_cloth[b as usize])
                 .collect();
             assert_eq!(found, direct);
         }
@@ -257,7 +281,7 @@ mod tests {
             .map(|(&p, &v)| MovingBox { place: Aabb { min: p, max: p }, velocity: Aabb { min: v, max: v } })
             .collect();
         let mut tree = BoxTree::default();
-        tree.order_leaves(&moving.iter().map(|m| m.place).collect::<Vec<_>>());
+        tree.order_leaves(&moving.iter().map(|m| m.place).collect::<Vec<_>>(), &[true; 300]);
         tree.refit(&moving);
         let (horizon, reach) = (0.5, 0.02);
         let found: std::collections::HashSet<(u32, u32)> = tree
@@ -290,7 +314,7 @@ mod tests {
                 }
             })
             .collect();
-        tree.order_leaves(&grid.iter().map(|m| m.place).collect::<Vec<_>>());
+        tree.order_leaves(&grid.iter().map(|m| m.place).collect::<Vec<_>>(), &[true; 400]);
         tree.refit(&grid);
         assert!(tree.meeting_pairs(&tree, 1.0, 0.002).is_empty());
     }
