@@ -128,11 +128,15 @@ impl BoxTree {
         out
     }
 
-    /// Every element whose still box comes within `reach` of the still box `query`, into `out`.
-    pub fn near(&self, query: &MovingBox, reach: f32, out: &mut Vec<u32>) {
+    /// Every element whose still box comes within `reach` of the still box `query`, into `out`;
+    /// only the cloth's with `cloth_only` (the query is a layer's, which meets nothing else).
+    pub fn near(&self, query: &MovingBox, reach: f32, cloth_only: bool, out: &mut Vec<u32>) {
         let mut stack = vec![1usize];
         while let Some(node) = stack.pop() {
-            if self.order.is_empty() || !self.nodes[node].may_meet(query, 0.0, reach) {
+            if self.order.is_empty()
+                || (cloth_only && !self.cloth[node])
+                || !self.nodes[node].may_meet(query, 0.0, reach)
+            {
                 continue;
             }
             if self.is_leaf(node) {
@@ -250,9 +254,8 @@ mod tests {
             let mut queried = Vec::new();
             for (b, query) in others.iter().enumerate() {
                 let mut near = Vec::new();
-                tree.near(&MovingBox::still(*query), 0.0, &mut near);
-                let meets = |a: &u32| cloth[*a as usize] || others_cloth[b];
-                queried.extend(near.into_iter().filter(meets).map(|a| (a, b as u32)));
+                tree.near(&MovingBox::still(*query), 0.0, !others_cloth[b], &mut near);
+                queried.extend(near.into_iter().map(|a| (a, b as u32)));
             }
             queried.sort_unstable();
             assert_eq!(queried, found);

@@ -198,7 +198,8 @@ impl EdgeEdge {
             .filter(|&e| strayed(e))
             .flat_map_iter(|e| {
                 let mut found = Vec::new();
-                tree.near(&boxes[e as usize], reach, &mut found);
+                // A layer's edge meets only the cloth's.
+                tree.near(&boxes[e as usize], reach, !search.has_cloth(&edges[e as usize]), &mut found);
                 found.into_iter().filter(move |&f| f != e && (e < f || !strayed(f))).map(move |f| (e, f))
             })
             .filter_map(|(e, f)| admit(ends, search, e, f))

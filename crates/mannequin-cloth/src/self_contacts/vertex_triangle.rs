@@ -166,21 +166,23 @@ impl VertexTriangle {
         self.vertices.refit(&self.points);
         let (boxes, points, reach) = (&self.boxes, &self.points, search.reach.distance);
         let (triangles, vertices) = (&self.tree, &self.vertices);
-        let near = |tree: &BoxTree, query: &MovingBox| {
+        // A layer's element meets only the cloth's.
+        let near = |tree: &BoxTree, query: &MovingBox, particles: &[u32]| {
             let mut found = Vec::new();
-            tree.near(query, reach, &mut found);
+            tree.near(query, reach, !search.has_cloth(particles), &mut found);
             found
         };
         let from_vertices = (0..points.len() as u32)
             .into_par_iter()
             .filter(|&v| anchor.strayed(&[v]))
-            .flat_map_iter(|v| near(triangles, &points[v as usize]).into_iter().map(move |t| (v, t)));
+            .flat_map_iter(|v| near(triangles, &points[v as usize], &[v]).into_iter().map(move |t| (v, t)));
         let from_triangles = (0..faces.len() as u32)
             .into_par_iter()
             .filter(|&t| anchor.strayed(&faces[t as usize]))
             .flat_map_iter(|t| {
-                let others =
-                    near(vertices, &boxes[t as usize]).into_iter().filter(|&v| !anchor.strayed(&[v]));
+                let others = near(vertices, &boxes[t as usize], &faces[t as usize])
+                    .into_iter()
+                    .filter(|&v| !anchor.strayed(&[v]));
                 others.map(move |v| (v, t))
             });
         from_vertices
