@@ -117,8 +117,8 @@ impl BoxTree {
 
     /// Every pair (a of `self`, b of `other`), one of them the cloth's, whose boxes may come
     /// within `reach` within `horizon` ([`MovingBox`]), once; with `other` the same tree, every
-    /// unordered pair of two elements once, as (a, b) or (b, a). Walks both trees together, so a pair of subtrees apart
-    /// is passed over at once; the top of the walk runs in parallel.
+    /// unordered pair of two elements once, as (a, b) or (b, a). Walks both trees together, so a
+    /// pair of subtrees apart is passed over at once; the top of the walk runs in parallel.
     pub fn meeting_pairs(&self, other: &BoxTree, horizon: f32, reach: f32) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
         if !self.order.is_empty() && !other.order.is_empty() {

@@ -121,17 +121,14 @@ fn admit(ends: Ends, search: Search<[u32; 2]>, a: u32, b: u32) -> Option<(Pair, 
 }
 
 impl EdgeEdge {
-    /// Refits the tree to the edges' boxes, ordering its leaves first by `initial`, the cloth's
-    /// start shape, and walks it for the pairs that may come within `reach` within `horizon`.
-    fn meeting(&mut self, search: Search<[u32; 2]>, horizon: f32, reach: f32) -> Vec<(u32, u32)> {
-        let (initial, edges) = (search.initial, search.elements);
-        if !self.tree.is_ordered_for(edges.len()) {
-            let start = Ends { from: initial, to: initial };
-            let cloth: Vec<bool> = edges.iter().map(|e| search.has_cloth(e)).collect();
-            self.tree.order_leaves(&edges.iter().map(|e| start.swept(e)).collect::<Vec<_>>(), &cloth);
+    /// Refits the tree to the edges' boxes, ordering its leaves first ([`Search::order_leaves`]),
+    /// and walks it for the pairs that may come within reach within `horizon`.
+    fn meeting(&mut self, search: Search<[u32; 2]>, horizon: f32) -> Vec<(u32, u32)> {
+        if !self.tree.is_ordered_for(search.elements.len()) {
+            search.order_leaves(&mut self.tree, search.elements);
         }
         self.tree.refit(&self.boxes);
-        self.tree.meeting_pairs(&self.tree, horizon, reach)
+        self.tree.meeting_pairs(&self.tree, horizon, search.reach.distance)
     }
 
     /// Watches, from `anchor` to its horizon, every pair of edges without a common vertex whose
@@ -141,7 +138,7 @@ impl EdgeEdge {
         let edges = search.elements;
         self.boxes.clear();
         self.boxes.extend(edges.iter().map(|e| anchor.moving(e)));
-        let pairs = self.meeting(search, anchor.horizon, search.reach.distance);
+        let pairs = self.meeting(search, anchor.horizon);
         self.watched = pairs
             .into_par_iter()
             .filter_map(|(a, b)| {

@@ -1,7 +1,9 @@
 //! What deciding whether a pair of elements is a substep's contact needs to know.
 
+use super::ends::Ends;
 use super::neighbours::Neighbours;
 use super::push::Reach;
+use crate::box_tree::BoxTree;
 
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Search<'a, E> {
@@ -35,5 +37,14 @@ impl<'a, E> Search<'a, E> {
     /// Whether a pair of these particles has one of the cloth's.
     pub fn has_cloth(&self, particles: &[u32]) -> bool {
         particles.iter().any(|&p| p < self.cloth)
+    }
+
+    /// Orders `tree`'s leaves for `elements` (each a few particles) by where they are in the
+    /// cloth's start shape, the cloth's elements before the layers'.
+    pub fn order_leaves<const K: usize>(&self, tree: &mut BoxTree, elements: &[[u32; K]]) {
+        let start = Ends { from: self.initial, to: self.initial };
+        let boxes: Vec<_> = elements.iter().map(|e| start.swept(e)).collect();
+        let cloth: Vec<bool> = elements.iter().map(|e| self.has_cloth(e)).collect();
+        tree.order_leaves(&boxes, &cloth);
     }
 }

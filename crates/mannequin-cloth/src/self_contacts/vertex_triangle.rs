@@ -79,21 +79,18 @@ fn admit(ends: Ends, search: Search<[u32; 3]>, vertex: u32, triangle: u32) -> Op
 
 impl VertexTriangle {
     /// Refits the trees to the triangles' `boxes` and the vertices' `points`, ordering their
-    /// leaves first by `initial`, the cloth's start shape, and walks them for the pairs that may
-    /// come within `reach` within `horizon`, the triangle not having the vertex as a corner.
-    fn meeting(&mut self, search: Search<[u32; 3]>, horizon: f32, reach: f32) -> Vec<(u32, u32)> {
-        let (initial, faces) = (search.initial, search.elements);
+    /// leaves first ([`Search::order_leaves`]), and walks them for the pairs that may come
+    /// within reach within `horizon`, the triangle not having the vertex as a corner.
+    fn meeting(&mut self, search: Search<[u32; 3]>, horizon: f32) -> Vec<(u32, u32)> {
+        let faces = search.elements;
         if !self.tree.is_ordered_for(faces.len()) {
-            let start = Ends { from: initial, to: initial };
-            let cloth: Vec<bool> = faces.iter().map(|t| search.has_cloth(t)).collect();
-            self.tree.order_leaves(&faces.iter().map(|t| start.swept(t)).collect::<Vec<_>>(), &cloth);
-            let vertices = 0..initial.len() as u32;
-            let cloth: Vec<bool> = vertices.clone().map(|v| search.has_cloth(&[v])).collect();
-            self.vertices.order_leaves(&vertices.map(|v| start.swept(&[v])).collect::<Vec<_>>(), &cloth);
+            search.order_leaves(&mut self.tree, faces);
+            let vertices: Vec<[u32; 1]> = (0..search.initial.len() as u32).map(|v| [v]).collect();
+            search.order_leaves(&mut self.vertices, &vertices);
         }
         self.tree.refit(&self.boxes);
         self.vertices.refit(&self.points);
-        let mut pairs = self.vertices.meeting_pairs(&self.tree, horizon, reach);
+        let mut pairs = self.vertices.meeting_pairs(&self.tree, horizon, search.reach.distance);
         pairs.retain(|&(vertex, triangle)| !faces[triangle as usize].contains(&vertex));
         pairs
     }
@@ -106,7 +103,7 @@ impl VertexTriangle {
         self.boxes.extend(faces.iter().map(|t| anchor.moving(t)));
         self.points.clear();
         self.points.extend((0..initial.len() as u32).map(|v| anchor.moving(&[v])));
-        let pairs = self.meeting(search, anchor.horizon, search.reach.distance);
+        let pairs = self.meeting(search, anchor.horizon);
         self.watched = pairs
             .into_par_iter()
             .filter_map(|(vertex, triangle)| {
