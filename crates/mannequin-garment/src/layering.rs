@@ -101,7 +101,7 @@ impl Garment {
                 let Some((on, q)) = surface.query_within(p, CLEARING_REACH * gap) else { continue };
                 let (n, apart) = (normals[on.face as usize], p - q);
                 let clearance = apart.dot(n);
-                if clearance < gap && apart.length() < CLEARING_REACH * gap {
+                if clearance < gap {
                     *d = (Vec3::from(*d) + (gap - clearance) * n).to_array();
                     pushed = true;
                 }
