@@ -4,6 +4,7 @@
 pub mod default_body;
 pub mod error;
 pub mod face_model;
+pub mod gait_cycle;
 pub mod kinematics;
 pub mod lbs;
 pub mod lbs_tensor;
@@ -17,7 +18,6 @@ pub mod settling;
 pub mod skinned_export;
 pub mod smpl_joint;
 pub mod smpl_npz;
-pub mod walk_cycle;
 pub mod weight_transfer;
 
 pub use error::BodyError;

@@ -8,11 +8,13 @@
 //! `cargo bench -p mannequin-garment --bench dress [-- --seconds 4]`
 
 use std::path::Path;
-use std::time::Instant;
 
 use mannequin_body::{BodyModel, Motion};
 use mannequin_cloth::Performer;
-use mannequin_garment::{DressJob, DressSettings, Wardrobe, dress};
+use mannequin_garment::{DressJob, DressSettings};
+
+mod common;
+use common::time_dressing;
 
 /// The target for the whole job, seconds.
 const TARGET_S: f64 = 20.0;
@@ -28,18 +30,6 @@ fn stages(dir: &Path) -> String {
         .collect();
     parts.sort();
     parts.join(", ")
-}
-
-/// Seconds to dress `job` with `settings` and write its outputs into `out`.
-fn time_dressing(job: &DressJob, settings: &DressSettings, out: &Path) -> f64 {
-    let start = Instant::now();
-    std::fs::create_dir_all(out).unwrap();
-    let wardrobe = Wardrobe::load(job, settings).unwrap();
-    let mut dressing = dress(&wardrobe, job, settings, out).unwrap();
-    let metrics = dressing.measure();
-    dressing.write(out, job, &metrics).unwrap();
-    dressing.finish();
-    start.elapsed().as_secs_f64()
 }
 
 fn main() {

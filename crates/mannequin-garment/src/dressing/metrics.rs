@@ -18,6 +18,8 @@ pub struct FrameMetrics {
     pub vertices_inside_body: usize,
     /// Triangle pairs crossing the layers under this one.
     pub crossings_with_inner_layers: usize,
+    /// Pairs of this garment's own triangles that cross each other.
+    pub self_intersecting_pairs: usize,
     pub max_edge_strain: f32,
     pub mean_edge_strain: f32,
     /// The 99th percentile of the edges' stretch (compression left out).
@@ -62,6 +64,7 @@ pub(super) fn measure(
                             body_faces,
                         ),
                         crossings_with_inner_layers,
+                        self_intersecting_pairs: quality::self_intersecting_pairs(positions, faces),
                         max_edge_strain,
                         mean_edge_strain,
                         p99_edge_stretch: quality::stretch_quantile(&rest, positions, faces, 0.99),
@@ -93,6 +96,7 @@ pub(super) fn write_metrics(
                 "vertices": w.garment.vertex_count(),
                 "max_vertices_inside_body": m.iter().map(|x| x.vertices_inside_body).max(),
                 "max_crossings_with_inner_layers": m.iter().map(|x| x.crossings_with_inner_layers).max(),
+                "max_self_intersecting_pairs": m.iter().map(|x| x.self_intersecting_pairs).max(),
                 "max_edge_strain": m.iter().map(|x| x.max_edge_strain).fold(0.0f32, f32::max),
                 "mean_edge_strain": m.iter().map(|x| x.mean_edge_strain).sum::<f32>() / m.len().max(1) as f32,
                 "max_p99_edge_stretch": m.iter().map(|x| x.p99_edge_stretch).fold(0.0f32, f32::max),
@@ -114,11 +118,12 @@ pub(super) fn write_metrics(
         .map_err(|reason| SimulateError::Write { path: path.display().to_string(), reason })?;
     for g in summary["garments"].as_array().into_iter().flatten() {
         tracing::info!(
-            "{}: at most {} vertices inside the body, {} crossings with inner layers; strain mean {:.3}, \
-             max {:.3}; 99 % of edges stretched under {:.3} (the material's limit: {})",
+            "{}: at most {} vertices inside the body, {} crossings with inner layers, {} with itself; \
+             strain mean {:.3}, max {:.3}; 99 % of edges stretched under {:.3} (the material's limit: {})",
             g["name"],
             g["max_vertices_inside_body"],
             g["max_crossings_with_inner_layers"],
+            g["max_self_intersecting_pairs"],
             g["mean_edge_strain"].as_f64().unwrap_or(0.0),
             g["max_edge_strain"].as_f64().unwrap_or(0.0),
             g["max_p99_edge_stretch"].as_f64().unwrap_or(0.0),
