@@ -20,7 +20,7 @@ use crate::sewing::sew_skirt;
 
 /// Changes whenever a recipe makes a different mesh, so that templates cached by an older one
 /// are made anew.
-pub const TEMPLATE_REVISION: u32 = 3;
+pub const TEMPLATE_REVISION: u32 = 4;
 
 /// Remeshing rounds: Botsch & Kobbelt find 5–10 enough; the body's 5 cm edges need the upper end.
 const REMESH_ROUNDS: usize = 10;

@@ -7,10 +7,13 @@
 //! four moves mₖ and their mean m̄. A pair whose moves spread less than its start distance allows
 //! (`SHARE`) cannot pass through itself, however far it travels: cloth carried by a swinging leg,
 //! and the layers on it, move freely together. Where a pair's moves spread too far, its free
-//! particles are drawn to the pair's mean move (several rounds, as neighbouring pairs share
-//! particles), each kept within its room (near the box around its own move, so that pairs left
-//! out of the candidates stay apart); what still spreads too far after that is stopped where it
-//! started the substep, and so on until nothing does, which stopping everything free achieves.
+//! particles are drawn to the pair's mean move, or to the move of the layer in the pair where it
+//! has one, as a layer under the cloth does not yield (several rounds, as neighbouring pairs
+//! share particles), each kept within its room (the box around its own move, so that pairs left
+//! out of the candidates stay apart); what still spreads too far after that is carried once with
+//! its pair's layer, then stopped where it started the substep, and so on until nothing does,
+//! which stopping everything free achieves. Stopped outright, cloth in a layer's way is run
+//! through by it: a T-shirt's hem pressed against a skirt's waist by a jogger's hands.
 //!
 //! The spread bounds how far a pair can close, not whether it does: a pair pushed apart spreads
 //! as much as one driven through. So a pair also passes whose elements' projections on the line
@@ -72,6 +75,8 @@ pub(super) struct SafeStep {
     incident: Vec<u32>,
     /// The round in which each pair was last queued, so it is queued once a round.
     queued: Vec<usize>,
+    /// Particles already stopped once, carried with a layer: a second stop is where they started.
+    carried: Vec<bool>,
 }
 
 impl SafeStep {
@@ -109,7 +114,8 @@ impl SafeStep {
             self.sums.resize(self.moves.len(), (Vec3::ZERO, 0));
             for &k in &spreading {
                 let particles = pairs[k as usize].particles;
-                let mean = particles.iter().map(|&p| self.moves[p as usize]).sum::<Vec3>() / 4.0;
+                let mean = carrier(particles, &self.moves, &free)
+                    .unwrap_or_else(|| particles.iter().map(|&p| self.moves[p as usize]).sum::<Vec3>() / 4.0);
                 for p in particles.into_iter().filter(|&p| free(p)) {
                     let sum = &mut self.sums[p as usize];
                     *sum = (sum.0 + mean, sum.1 + 1);
@@ -130,16 +136,29 @@ impl SafeStep {
                 break;
             }
         }
-        // Stopping a pair's free particles may make its neighbours spread: follow them until
-        // none does.
+        // What still spreads is stopped: carried with the layer in the pair, once, where the
+        // pair has one (a particle stopped where it started is run through by a layer that moves
+        // on), and where it started after that. Stopping a pair's free particles may make its
+        // neighbours spread: follow them until none does.
+        self.carried.clear();
+        self.carried.resize(self.moves.len(), false);
         let mut round = ROUNDS + 1;
         while !spreading.is_empty() {
             let mut stopped = Vec::new();
             for &k in &spreading {
-                for p in pairs[k as usize].particles.into_iter().filter(|&p| free(p)) {
-                    if self.moves[p as usize] != Vec3::ZERO {
-                        self.moves[p as usize] = Vec3::ZERO;
-                        stopped.push(p);
+                let particles = pairs[k as usize].particles;
+                let layer = carrier(particles, &self.moves, &free);
+                for p in particles.into_iter().filter(|&p| free(p)) {
+                    let p = p as usize;
+                    let start = Vec3::from(previous[p]);
+                    let stop = match layer {
+                        Some(m) if !self.carried[p] => (start + m).clamp(room[p].min, room[p].max) - start,
+                        _ => Vec3::ZERO,
+                    };
+                    self.carried[p] = true;
+                    if self.moves[p] != stop {
+                        self.moves[p] = stop;
+                        stopped.push(p as u32);
                     }
                 }
             }
@@ -190,6 +209,16 @@ impl SafeStep {
         }
         out
     }
+}
+
+/// The mean move of a pair's kinematic particles (a layer under the cloth), if it has any: the
+/// move its free particles are drawn to, as the layer does not yield.
+fn carrier(particles: [u32; 4], moves: &[Vec3], free: impl Fn(u32) -> bool) -> Option<Vec3> {
+    let (sum, count) = particles
+        .iter()
+        .filter(|&&p| !free(p))
+        .fold((Vec3::ZERO, 0), |(sum, count), &p| (sum + moves[p as usize], count + 1));
+    (count > 0).then(|| sum / count as f32)
 }
 
 /// The most a pair's distance can fall along its four moves: twice their farthest from their mean.
