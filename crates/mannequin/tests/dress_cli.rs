@@ -79,35 +79,15 @@ fn pants_and_a_tshirt_walk_on_five_body_shapes() {
     let cache = dir.join("cache");
     for (i, betas) in ["0,0", "2,0", "-2,0", "0,2", "0,-2"].iter().enumerate() {
         let out = dir.join(format!("shape_{i}"));
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"))
-            .args([
-                "dress",
-                "--garments",
-                "pants,tshirt",
-                "--betas",
-                betas,
-                "--motion",
-                s(&walk),
-                "--out",
-                s(&out),
-            ])
-            .args(if i == 0 { &[][..] } else { &["--no-frames"][..] })
-            .env("XDG_CACHE_HOME", &cache)
-            .output()
-            .unwrap();
-        ok(o);
+        let frames = if i == 0 { &[][..] } else { &["--no-frames"][..] };
+        let args = ["--garments", "pants,tshirt", "--betas", betas, "--motion", s(&walk), "--out", s(&out)];
+        ok(dress(&[&args[..], frames].concat(), &cache));
         let metrics = read_json(&out.join("metrics.json"));
         assert_eq!(metrics["frames"], 30);
         for g in metrics["garments"].as_array().unwrap() {
             let name = g["name"].as_str().unwrap();
-            assert_eq!(
-                g["max_vertices_inside_body"], 0,
-                "betas {betas}, {name}: {}",
-                g["max_vertices_inside_body"]
-            );
             // The T-shirt's contacts hold it off the pants (without them it crosses in 30–86 pairs).
-            assert_eq!(g["max_crossings_with_inner_layers"], 0, "betas {betas}, {name}");
-            assert_eq!(g["max_self_intersecting_pairs"], 0, "betas {betas}, {name} crosses itself");
+            assert_holds(g, &format!("betas {betas}"));
             let cache = PointCache::read(&out.join(format!("{name}.pc2"))).unwrap();
             assert_eq!(cache.frames.len(), 30);
             assert_eq!(cache.frames[0].len() as u64, g["vertices"].as_u64().unwrap());
@@ -115,13 +95,8 @@ fn pants_and_a_tshirt_walk_on_five_body_shapes() {
         if i == 0 {
             // Skinning alone (Eqs. 3.2-3.3) leaves cloth inside the body, which the simulator resolved.
             let skinned = dir.join("skinned");
-            let o = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"))
-                .args(["dress", "--garments", "pants,tshirt", "--motion", s(&walk), "--no-simulation"])
-                .args(["--no-frames", "--out", s(&skinned)])
-                .env("XDG_CACHE_HOME", &cache)
-                .output()
-                .unwrap();
-            ok(o);
+            let args = ["--garments", "pants,tshirt", "--motion", s(&walk), "--no-simulation", "--no-frames"];
+            ok(dress(&[&args[..], &["--out", s(&skinned)]].concat(), &cache));
             let inside: u64 = read_json(&skinned.join("metrics.json"))["garments"]
                 .as_array()
                 .unwrap()
@@ -147,19 +122,28 @@ fn a_tshirt_over_a_skirt_holds_on_the_jog() {
     let jog = dir.join("jog.npz");
     ok(mannequin(&["motion", "jog", "-o", s(&jog), "--seconds", "0.5"]));
     let out = dir.join("out");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"))
-        .args(["dress", "--garments", "skirt,tshirt", "--motion", s(&jog), "--no-frames", "--out", s(&out)])
-        .env("XDG_CACHE_HOME", dir.join("cache"))
-        .output()
-        .unwrap();
-    ok(o);
+    let args = ["--garments", "skirt,tshirt", "--motion", s(&jog), "--no-frames", "--out", s(&out)];
+    ok(dress(&args, &dir.join("cache")));
     let metrics = read_json(&out.join("metrics.json"));
     assert_eq!(metrics["frames"], 15);
     for g in metrics["garments"].as_array().unwrap() {
-        let name = g["name"].as_str().unwrap();
-        assert_eq!(g["max_vertices_inside_body"], 0, "{name}");
-        assert_eq!(g["max_crossings_with_inner_layers"], 0, "{name}");
-        assert_eq!(g["max_self_intersecting_pairs"], 0, "{name}");
+        assert_holds(g, "the jog");
+    }
+}
+
+/// `mannequin dress ARGS` with its garment cache in `cache`, apart from the user's.
+fn dress(args: &[&str], cache: &Path) -> std::process::Output {
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"));
+    command.arg("dress").args(args).env("XDG_CACHE_HOME", cache).output().unwrap()
+}
+
+/// A garment of a run's metrics.json (`what` names the run) that held at every frame: no vertex
+/// inside the body, no pair crossing the layers under it or itself.
+fn assert_holds(g: &serde_json::Value, what: &str) {
+    let name = g["name"].as_str().unwrap();
+    for key in ["max_vertices_inside_body", "max_crossings_with_inner_layers", "max_self_intersecting_pairs"]
+    {
+        assert_eq!(g[key], 0, "{what}, {name}: {key}");
     }
 }
 

@@ -114,7 +114,7 @@ impl SafeStep {
             self.sums.resize(self.moves.len(), (Vec3::ZERO, 0));
             for &k in &spreading {
                 let particles = pairs[k as usize].particles;
-                let mean = carrier(particles, &self.moves, &free)
+                let mean = carrier(particles, &self.moves, free)
                     .unwrap_or_else(|| particles.iter().map(|&p| self.moves[p as usize]).sum::<Vec3>() / 4.0);
                 for p in particles.into_iter().filter(|&p| free(p)) {
                     let sum = &mut self.sums[p as usize];
@@ -147,7 +147,7 @@ impl SafeStep {
             let mut stopped = Vec::new();
             for &k in &spreading {
                 let particles = pairs[k as usize].particles;
-                let layer = carrier(particles, &self.moves, &free);
+                let layer = carrier(particles, &self.moves, free);
                 for p in particles.into_iter().filter(|&p| free(p)) {
                     let p = p as usize;
                     let start = Vec3::from(previous[p]);
