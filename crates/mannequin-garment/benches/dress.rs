@@ -14,14 +14,13 @@ use mannequin_cloth::Performer;
 use mannequin_garment::{DressJob, DressSettings};
 
 mod common;
-use common::time_dressing;
+use common::{read_metrics, time_dressing};
 
 /// The target for the whole job, seconds.
 const TARGET_S: f64 = 20.0;
 
 fn stages(dir: &Path) -> String {
-    let metrics: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("metrics.json")).unwrap()).unwrap();
+    let metrics = read_metrics(dir);
     let mut parts: Vec<String> = metrics["stage_s"]
         .as_object()
         .unwrap()

@@ -17,7 +17,7 @@ use mannequin_cloth::Performer;
 use mannequin_garment::{DressJob, DressSettings};
 
 mod common;
-use common::time_dressing;
+use common::{read_metrics, time_dressing};
 
 /// Inner layer first.
 const OUTFITS: [&str; 10] = [
@@ -41,8 +41,7 @@ fn option<'a>(args: &'a [String], name: &str) -> Option<&'a str> {
 /// Per garment of the run in `dir`: (name, inside, crossing the layers under, crossing itself,
 /// p99 stretch, the material's limit).
 fn worst(dir: &Path) -> Vec<(String, u64, u64, u64, f64, f64)> {
-    let metrics: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("metrics.json")).unwrap()).unwrap();
+    let metrics = read_metrics(dir);
     let count = |g: &serde_json::Value, k: &str| g[k].as_u64().unwrap_or(0);
     metrics["garments"]
         .as_array()

@@ -17,3 +17,8 @@ pub fn time_dressing(job: &DressJob, settings: &DressSettings, out: &Path) -> f6
     dressing.finish();
     start.elapsed().as_secs_f64()
 }
+
+/// The metrics.json a dressing run wrote into `dir`.
+pub fn read_metrics(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("metrics.json")).unwrap()).unwrap()
+}
