@@ -163,10 +163,16 @@ fn an_xl_tshirt_stays_on_the_shoulders_on_the_jog() {
     assert!(mean < 0.08, "the XL T-shirt's top tenth ends {mean} m from its skinned place");
 }
 
-/// `mannequin dress ARGS` with its garment cache in `cache`, apart from the user's.
+/// `mannequin dress ARGS` run to its end, with its garment cache in `cache`.
 fn dress(args: &[&str], cache: &Path) -> std::process::Output {
+    dress_command(args, cache).output().unwrap()
+}
+
+/// `mannequin dress ARGS` with its garment cache in `cache`, apart from the user's.
+fn dress_command(args: &[&str], cache: &Path) -> std::process::Command {
     let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"));
-    command.arg("dress").args(args).env("XDG_CACHE_HOME", cache).output().unwrap()
+    command.arg("dress").args(args).env("XDG_CACHE_HOME", cache);
+    command
 }
 
 /// A garment of a run's metrics.json (`what` names the run) that held at every frame: no vertex
@@ -189,13 +195,9 @@ fn a_killed_dress_resumes_to_the_same_frames() {
     ok(mannequin(&["motion", "walk", "-o", s(&walk), "--seconds", "0.5"]));
     let cache = dir.join("cache");
     let run = |out: &Path, extra: &[&str]| {
-        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_mannequin"));
-        command
-            .args(["dress", "--garments", "pants,tshirt", "--motion", s(&walk), "--settle", "0.4"])
-            .args(["--no-frames", "--checkpoint-every", "5", "--out", s(out)])
-            .args(extra)
-            .env("XDG_CACHE_HOME", &cache);
-        command
+        let args = ["--garments", "pants,tshirt", "--motion", s(&walk), "--settle", "0.4", "--no-frames"];
+        let args = [&args[..], &["--checkpoint-every", "5", "--out", s(out)], extra].concat();
+        dress_command(&args, &cache)
     };
     let whole = dir.join("whole");
     ok(run(&whole, &[]).output().unwrap());
