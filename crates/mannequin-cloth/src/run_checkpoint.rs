@@ -46,18 +46,19 @@ fn read_points(npz: &Npz, key: &str, shape: &[Option<usize>]) -> Result<Vec<[f32
     Ok(points(&values.into_iter().map(|x| x as f32).collect::<Vec<_>>()))
 }
 
-/// The cloth simulator's state as "positions" and "velocities" [vertices, 3] arrays.
-pub fn add_state(w: &mut NpzWriter, state: &ClothState) {
+/// The cloth simulator's state as "positions" and "velocities" [vertices, 3] arrays, each name
+/// followed by `suffix` (a run of several cloths tells theirs apart by it).
+pub fn add_state(w: &mut NpzWriter, state: &ClothState, suffix: &str) {
     for (key, values) in [("positions", &state.positions), ("velocities", &state.velocities)] {
         let flat = values.iter().flatten().copied().collect();
-        w.add(key, NpyArray::f32(vec![values.len(), 3], flat));
+        w.add(&format!("{key}{suffix}"), NpyArray::f32(vec![values.len(), 3], flat));
     }
 }
 
-/// The state [`add_state`] stored, checked against `vertices` and the physical bounds
-/// ([`ClothState::check`]).
-pub fn read_state(npz: &Npz, vertices: usize) -> Result<ClothState, SimulateError> {
-    let read = |key: &str| read_points(npz, key, &[Some(vertices), Some(3)]);
+/// The state [`add_state`] stored with `suffix`, checked against `vertices` and the physical
+/// bounds ([`ClothState::check`]).
+pub fn read_state(npz: &Npz, vertices: usize, suffix: &str) -> Result<ClothState, SimulateError> {
+    let read = |key: &str| read_points(npz, &format!("{key}{suffix}"), &[Some(vertices), Some(3)]);
     let state = ClothState { positions: read("positions")?, velocities: read("velocities")? };
     state.check(vertices).map_err(|e| SimulateError::from(e).of(npz.path.display().to_string()))?;
     Ok(state)

@@ -17,7 +17,9 @@ pub(crate) type Layer<'a> = (&'a [[u32; 3]], &'a [Vec<[f32; 3]>]);
 /// centimetres off its skinned place, and hands swing past the hips.
 const REACH: f32 = 0.1;
 
-/// The collider's vertices: the kept body vertices followed by the inner layers'.
+/// The collider's vertices: the kept body vertices followed by the inner layers'. The inner
+/// layers' positions are passed in at each frame, so a layer can be simulated while those under
+/// it are still going on ahead of it.
 pub(crate) struct Collider<'a> {
     kept: Vec<u32>,
     /// Triangles over the kept body vertices.
@@ -25,7 +27,6 @@ pub(crate) struct Collider<'a> {
     /// The inner layers' triangles, over their own vertices.
     layer_faces: Vec<[u32; 3]>,
     body_frames: &'a [Vec<[f32; 3]>],
-    inner: &'a [Layer<'a>],
 }
 
 impl<'a> Collider<'a> {
@@ -33,7 +34,7 @@ impl<'a> Collider<'a> {
     pub fn new(
         body_frames: &'a [Vec<[f32; 3]>],
         body_faces: &[[u32; 3]],
-        inner: &'a [Layer<'a>],
+        inner: &[Layer],
         skinned: &[(usize, Vec<[f32; 3]>)],
     ) -> Self {
         let cell = |p: &[f32; 3]| p.map(|x| (2.0 * x / REACH).floor() as i32);
@@ -60,24 +61,24 @@ impl<'a> Collider<'a> {
             layer_faces.extend(f.iter().map(|t| t.map(|i| i + offset)));
             offset += frames[0].len() as u32;
         }
-        Self { kept, faces: part.faces, layer_faces, body_frames, inner }
+        Self { kept, faces: part.faces, layer_faces, body_frames }
     }
 
-    /// The body part as a collider, wearing the inner layers.
-    pub fn body(&self) -> Result<Body, ClothError> {
+    /// The body part as a collider, wearing the `inner` layers (the same as [`Collider::new`]'s).
+    pub fn body(&self, inner: &[Layer]) -> Result<Body, ClothError> {
         let body = Body::new(self.faces.clone());
-        if self.inner.is_empty() {
+        if inner.is_empty() {
             return Ok(body);
         }
-        let rest = self.at(0).split_off(self.kept.len());
+        let rest = self.at(0, inner).split_off(self.kept.len());
         body.with_layers(Layers { first_vertex: self.kept.len(), faces: self.layer_faces.clone(), rest })
     }
 
-    /// The collider's vertices at schedule frame `k`.
-    pub fn at(&self, k: usize) -> Vec<[f32; 3]> {
+    /// The collider's vertices at schedule frame `k`, which each of the `inner` layers has reached.
+    pub fn at(&self, k: usize, inner: &[Layer]) -> Vec<[f32; 3]> {
         let body = &self.body_frames[k];
         let mut all: Vec<[f32; 3]> = self.kept.iter().map(|&v| body[v as usize]).collect();
-        for (_, frames) in self.inner {
+        for (_, frames) in inner {
             all.extend_from_slice(&frames[k]);
         }
         all

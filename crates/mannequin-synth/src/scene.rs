@@ -325,8 +325,8 @@ impl Scene {
         let wearer = Wearer { faces: &self.body_faces, frames: &body_frames, schedule: &schedule, fps };
         let settings =
             Settings { substeps: Settings::substeps_at(fps), self_collision, ..Settings::default() };
-        let layers = wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |_| {
-            on_step(Step::Simulated);
+        let layers = wear::<GarmentError>(&named, &wearer, settings, WearProgress::default(), &mut |step| {
+            (0..step.stepped).for_each(|_| on_step(Step::Simulated));
             Ok(())
         })
         .map_err(fail)?;

@@ -397,7 +397,7 @@ fn checkpoints() {
     };
     let mut w = NpzWriter::new();
     mannequin_io::run_record::write_run(&mut w, &run);
-    add_state(&mut w, &state);
+    add_state(&mut w, &state, "");
     w.add("frames", frames_array(&[state.positions.clone(), state.positions.clone()], 4));
     let cloth = w.to_bytes();
     let training = training_checkpoint();
@@ -413,7 +413,7 @@ fn checkpoints() {
             });
         }
         check_run(&npz, &run).map_err(|e| e.to_string())?;
-        read_state(&npz, 4).map_err(|e| e.to_string())?;
+        read_state(&npz, 4, "").map_err(|e| e.to_string())?;
         read_frames(&npz, "frames", 4).map(drop).map_err(|e| e.to_string())
     });
 }

@@ -53,7 +53,7 @@ pub(super) fn write_checkpoint(
     let mut w = NpzWriter::new();
     mannequin_io::run_record::write_run(&mut w, run);
     w.add("next", NpyArray::i64(vec![1], vec![progress.next as i64]));
-    add_state(&mut w, state);
+    add_state(&mut w, state, "");
     w.add("frames", frames_array(&progress.frames, state.positions.len()));
     let metrics = serde_json::to_string(&progress.metrics)
         .map_err(|e| SimulateError::invalid("metrics", e.to_string()))?;
@@ -87,7 +87,7 @@ pub(super) fn read_checkpoint(
             ),
         ));
     };
-    let state = read_state(&npz, vertices)?;
+    let state = read_state(&npz, vertices, "")?;
     let frames = read_frames(&npz, "frames", vertices)?;
     let recorded = next.saturating_sub(schedule.settle);
     if frames.len() != recorded {

@@ -1,6 +1,6 @@
-//! A dressing's checkpoint: its record (everything that changes the simulation), the frames of
-//! the layers finished (inner first) and of the one under way with the cloth's state. A
-//! checkpoint of another run is refused naming what changed.
+//! A dressing's checkpoint: its record (everything that changes the simulation), and per layer
+//! (inner first) its frames so far and the cloth's state. A checkpoint of another run is refused
+//! naming what changed.
 
 use std::path::Path;
 
@@ -40,7 +40,7 @@ pub(super) fn template_hash(g: &Garment) -> String {
     mannequin_io::fingerprint::hash_bytes(&bytes)
 }
 
-/// Finished layers as `finished_<i>`, the one under way as `current` with the cloth's state.
+/// Layer i's frames as `frames_<i>` and its state as `positions_<i>` and `velocities_<i>`.
 pub(super) fn write_checkpoint(
     path: &Path,
     run: &DressRun,
@@ -49,12 +49,9 @@ pub(super) fn write_checkpoint(
 ) -> Result<(), DressError> {
     let mut w = NpzWriter::uncompressed();
     mannequin_io::run_record::write_run(&mut w, run);
-    for (i, (frames, layer)) in progress.finished.iter().zip(worn).enumerate() {
-        w.add(&format!("finished_{i}"), frames_array(frames, layer.garment.vertex_count()));
-    }
-    if let (Some(current), Some(layer)) = (&progress.current, worn.get(progress.finished.len())) {
-        w.add("current", frames_array(&current.frames, layer.garment.vertex_count()));
-        add_state(&mut w, &current.state);
+    for (i, (layer, worn)) in progress.layers.iter().zip(worn).enumerate() {
+        w.add(&format!("frames_{i}"), frames_array(&layer.frames, worn.garment.vertex_count()));
+        add_state(&mut w, &layer.state, &format!("_{i}"));
     }
     w.write(path)?;
     Ok(())
@@ -73,16 +70,9 @@ pub(super) fn read_checkpoint(
     let mut progress = WearProgress::default();
     for (i, (_, layer)) in layers.iter().enumerate() {
         let vertices = layer.garment().vertex_count();
-        let key = format!("finished_{i}");
-        if npz.contains(&key) {
-            progress.finished.push(read_frames(&npz, &key, vertices)?);
-        } else {
-            if npz.contains("current") {
-                let frames = read_frames(&npz, "current", vertices)?;
-                progress.current = Some(LayerProgress { frames, state: read_state(&npz, vertices)? });
-            }
-            break;
-        }
+        let frames = read_frames(&npz, &format!("frames_{i}"), vertices)?;
+        let state = read_state(&npz, vertices, &format!("_{i}"))?;
+        progress.layers.push(LayerProgress { frames, state });
     }
     progress.check(layers, schedule).map_err(|e| DressError::from(e).of(path.display().to_string()))?;
     Ok(progress)

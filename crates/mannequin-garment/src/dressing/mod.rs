@@ -1,7 +1,7 @@
 //! Dressing (`mannequin dress`): garments put on a body of any shape (thesis Eqs. 3.1–3.3) and
 //! worn through a motion, the cloth simulator resolving what skinning cannot (gravity on loose
-//! parts, the body pushing through after a shape change). Layers are simulated inner first;
-//! each one collides with the body and with every layer under it. A run saves checkpoints and
+//! parts, the body pushing through after a shape change). Each layer collides with the body and
+//! with every layer under it, the layers stepping side by side ([`crate::wear`]). A run saves checkpoints and
 //! resumes from them; its outputs are a scene, metrics and a fit report per body region.
 
 mod checkpoint;
@@ -181,7 +181,7 @@ impl<'a> Dressing<'a> {
             .collect()
     }
 
-    /// Each layer simulated at every frame of the schedule, inner first, saving `checkpoint`
+    /// Each layer simulated at every frame of the schedule, saving `checkpoint`
     /// every `settings.checkpoint_every` frames and resuming from it.
     fn simulated(
         &self,
@@ -222,16 +222,17 @@ impl<'a> Dressing<'a> {
         };
         let total = worn.len() * (self.schedule.len() - 1);
         let progress = mannequin_io::progress::bar(total as u64, "simulation");
-        let mut on_frame = |step: &WearStep| -> Result<(), DressError> {
+        let mut on_step = |step: &WearStep| -> Result<(), DressError> {
             let done = step.frames_done();
             progress.set_position(done as u64);
-            if settings.checkpoint_every > 0 && done.is_multiple_of(settings.checkpoint_every) && done < total
-            {
+            // A step simulates a frame of each layer under way: save when it passes a multiple.
+            let every = settings.checkpoint_every;
+            if every > 0 && done / every > (done - step.stepped) / every && done < total {
                 write_checkpoint(checkpoint, &run, &step.progress(), worn)?;
             }
             Ok(())
         };
-        let simulated = wear(&named, &wearer, solver, resume, &mut on_frame)?;
+        let simulated = wear(&named, &wearer, solver, resume, &mut on_step)?;
         progress.finish_and_clear();
         Ok(simulated
             .into_iter()
