@@ -60,6 +60,8 @@ pub fn add_state(w: &mut NpzWriter, state: &ClothState, suffix: &str) {
 pub fn read_state(npz: &Npz, vertices: usize, suffix: &str) -> Result<ClothState, SimulateError> {
     let read = |key: &str| read_points(npz, &format!("{key}{suffix}"), &[Some(vertices), Some(3)]);
     let state = ClothState { positions: read("positions")?, velocities: read("velocities")? };
-    state.check(vertices).map_err(|e| SimulateError::from(e).of(npz.path.display().to_string()))?;
+    // Named by its arrays: a checkpoint of several cloths holds several states.
+    let arrays = format!("{} (positions{suffix}, velocities{suffix})", npz.path.display());
+    state.check(vertices).map_err(|e| SimulateError::from(e).of(arrays))?;
     Ok(state)
 }

@@ -468,31 +468,31 @@ fn cloth_checkpoint_cases(fx: &Fixtures, dir: &Path, base: &Base, cases: &mut Ve
 
 fn dress_checkpoint_cases(fx: &Fixtures, dir: &Path, base: &Base, cases: &mut Vec<Case>) {
     let ckpt = &base.dress_checkpoint;
-    let vertices = array_of(ckpt, "positions").shape[0];
-    let current = array_of(ckpt, "current").shape;
+    let vertices = array_of(ckpt, "positions_0").shape[0];
+    let frames = array_of(ckpt, "frames_0").shape;
     let mut broken: Vec<(String, &str, Option<NpyArray>, String)> = Vec::new();
-    for key in ["positions", "velocities"] {
+    for key in ["positions_0", "velocities_0"] {
         for (what, array) in broken_floats(&array_of(ckpt, key), 1e3) {
             broken.push((what, key, Some(array), key.into()));
         }
     }
     broken.push((
         "past_sound".into(),
-        "velocities",
+        "velocities_0",
         Some(NpyArray::f32(vec![vertices, 3], vec![1e3; 3 * vertices])),
         "343 m/s".into(),
     ));
     // A layer's frames cut short are an earlier, whole checkpoint: not broken, so not here.
     for (what, array) in
-        broken_floats(&array_of(ckpt, "current"), 1e3).into_iter().filter(|(w, _)| w != "fewer_rows")
+        broken_floats(&array_of(ckpt, "frames_0"), 1e3).into_iter().filter(|(w, _)| w != "fewer_rows")
     {
-        broken.push((what, "current", Some(array), "current".into()));
+        broken.push((what, "frames_0", Some(array), "frames_0".into()));
     }
     let with_frames = |n: usize| Some(NpyArray::f32(vec![n, vertices, 3], vec![0.0; n * vertices * 3]));
-    broken.push(("outnumbering".into(), "current", with_frames(current[0] + 5), "current".into()));
-    broken.push(("none".into(), "current", with_frames(0), "current".into()));
-    broken.push(("finished_short".into(), "finished_0", with_frames(2), "finished".into()));
-    broken.push(("missing_state".into(), "velocities", None, "velocities".into()));
+    broken.push(("outnumbering".into(), "frames_0", with_frames(frames[0] + 500), "layers[0]".into()));
+    broken.push(("none".into(), "frames_0", with_frames(0), "layers[0]".into()));
+    broken.push(("missing_frames".into(), "frames_0", None, "frames_0".into()));
+    broken.push(("missing_state".into(), "velocities_0", None, "velocities_0".into()));
     broken.push(("other_run".into(), "run", Some(NpyArray::text("{\"garments\": []}")), "run".into()));
     let args = |case: &Path| dress(fx, case, &base.tshirt, &DRESS_FLAGS);
     checkpoint_cases(dir, "dress_checkpoint", ckpt, broken, &args, cases);
