@@ -10,7 +10,7 @@
 //! needs, and resumes from such a checkpoint bit for bit.
 
 use mannequin_body::Settling;
-use mannequin_cloth::{Attachment, Cloth, ClothState, PhaseTimes, Settings, Simulator};
+use mannequin_cloth::{Attachment, Cloth, ClothError, ClothState, PhaseTimes, Settings, Simulator};
 use rayon::prelude::*;
 
 use crate::collider::{Collider, Layer};
@@ -160,7 +160,12 @@ struct LayerRun<'a> {
     frames: Vec<Vec<[f32; 3]>>,
     /// The collider's vertices at the last frame.
     previous: Vec<[f32; 3]>,
-    settle: usize,
+}
+
+/// What turns the simulator's error into the layer `name`'s, `when` it happened.
+fn failed(name: &str, when: impl Into<String>) -> impl FnOnce(ClothError) -> GarmentError {
+    let (garment, when) = (name.to_string(), when.into());
+    move |error| GarmentError::Simulation { garment, when, error }
 }
 
 impl<'a> LayerRun<'a> {
@@ -179,11 +184,7 @@ impl<'a> LayerRun<'a> {
         let mut mesh = garment.mesh.clone();
         mesh.positions = rest.clone();
         let material = garment.recipe.material;
-        let failed = |when: &str| {
-            let when = when.to_string();
-            move |error| GarmentError::Simulation { garment: name.to_string(), when, error }
-        };
-        let cloth = Cloth::new(&mesh, &material, &[]).map_err(failed("at rest"))?;
+        let cloth = Cloth::new(&mesh, &material, &[]).map_err(failed(name, "at rest"))?;
 
         // The layer skinned (Eq. 3.3) every few frames says which part of the body it can meet.
         let skinned: Vec<(usize, Vec<[f32; 3]>)> = (0..wearer.frames.len())
@@ -201,30 +202,29 @@ impl<'a> LayerRun<'a> {
             .into_iter()
             .map(|v| Attachment::bind(&at_rest, &collider.faces, v, mesh.positions[v as usize]))
             .collect();
-        let body = collider.body(inner).map_err(failed("at rest"))?;
-        let mut sim = Simulator::new(cloth, Some(body), attachments, settings).map_err(failed("at rest"))?;
+        let body = collider.body(inner).map_err(failed(name, "at rest"))?;
+        let mut sim =
+            Simulator::new(cloth, Some(body), attachments, settings).map_err(failed(name, "at rest"))?;
         let frames = match resume {
             Some(progress) => {
-                sim.restore(progress.state).map_err(failed("resuming"))?;
+                sim.restore(progress.state).map_err(failed(name, "resuming"))?;
                 progress.frames
             }
             None => vec![rest],
         };
         let previous = collider.at(frames.len() - 1, inner);
         let faces = garment.mesh.faces.as_slice();
-        Ok(Self { name, faces, sim, collider, frames, previous, settle: wearer.schedule.settle })
+        Ok(Self { name, faces, sim, collider, frames, previous })
     }
 
     /// Simulates the next frame, the collider moving to `next`.
     fn step(&mut self, next: Vec<[f32; 3]>, wearer: &Wearer) -> Result<(), GarmentError> {
-        let k = self.frames.len();
-        self.sim.step_frame(&self.previous, &next, 1.0 / wearer.fps).map_err(|error| {
-            let when = match k < self.settle {
-                true => "while settling".to_string(),
-                false => format!("at motion frame {}", k - self.settle),
-            };
-            GarmentError::Simulation { garment: self.name.to_string(), when, error }
-        })?;
+        let (k, settle) = (self.frames.len(), wearer.schedule.settle);
+        let when = match k < settle {
+            true => "while settling".to_string(),
+            false => format!("at motion frame {}", k - settle),
+        };
+        self.sim.step_frame(&self.previous, &next, 1.0 / wearer.fps).map_err(failed(self.name, when))?;
         self.frames.push(self.sim.positions().to_vec());
         self.previous = next;
         Ok(())

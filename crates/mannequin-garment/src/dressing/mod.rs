@@ -1,8 +1,9 @@
 //! Dressing (`mannequin dress`): garments put on a body of any shape (thesis Eqs. 3.1–3.3) and
 //! worn through a motion, the cloth simulator resolving what skinning cannot (gravity on loose
 //! parts, the body pushing through after a shape change). Each layer collides with the body and
-//! with every layer under it, the layers stepping side by side ([`crate::wear`]). A run saves checkpoints and
-//! resumes from them; its outputs are a scene, metrics and a fit report per body region.
+//! with every layer under it, the layers stepping side by side ([`crate::wear`]). A run saves
+//! checkpoints and resumes from them; its outputs are a scene, metrics and a fit report per body
+//! region.
 
 mod checkpoint;
 mod fit_report;
@@ -181,8 +182,8 @@ impl<'a> Dressing<'a> {
             .collect()
     }
 
-    /// Each layer simulated at every frame of the schedule, saving `checkpoint`
-    /// every `settings.checkpoint_every` frames and resuming from it.
+    /// Each layer simulated at every frame of the schedule, saving `checkpoint` every
+    /// `settings.checkpoint_every` frames and resuming from it.
     fn simulated(
         &self,
         job: &DressJob,
