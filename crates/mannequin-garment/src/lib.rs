@@ -8,6 +8,7 @@ mod drape;
 mod dress_error;
 pub mod dressing;
 pub mod ease;
+mod ease_relief;
 mod error;
 pub mod file;
 mod garment;

@@ -13,6 +13,7 @@ use mannequin_mesh::{ClosestPoint, TriMesh, UvLayout};
 
 use crate::category::Category;
 use crate::ease::Ease;
+use crate::ease_relief::{check_uncrossed, smooth_out_crossings};
 use crate::error::GarmentError;
 use crate::garment::{Garment, Recipe, check_edge_length};
 use crate::region::{Landmarks, covered_region, open_front};
@@ -20,7 +21,7 @@ use crate::sewing::sew_skirt;
 
 /// Changes whenever a recipe makes a different mesh, so that templates cached by an older one
 /// are made anew.
-pub const TEMPLATE_REVISION: u32 = 4;
+pub const TEMPLATE_REVISION: u32 = 5;
 
 /// Remeshing rounds: Botsch & Kobbelt find 5–10 enough; the body's 5 cm edges need the upper end.
 const REMESH_ROUNDS: usize = 10;
@@ -85,6 +86,15 @@ pub fn make_garment(
             surface.query(p).map_or(p, |(_, q)| q)
         });
         mesh = TriMesh::new(positions, faces);
+    }
+    if smooth_out_crossings(&mut mesh.positions, &mesh.faces)? {
+        // Even out the triangles the smoothing squeezed, on the smoothed surface.
+        let smoothed = ClosestPoint::new(&mesh.positions, &mesh.faces, 0.03);
+        let (positions, faces) = remesh(&mesh.positions, &mesh.faces, edge_length, SEWN_REMESH_ROUNDS, |p| {
+            smoothed.query(p).map_or(p, |(_, q)| q)
+        });
+        mesh = TriMesh::new(positions, faces);
+        check_uncrossed(&mesh.positions, &mesh.faces, "after smoothing and remeshing")?;
     }
     let recipe = Recipe {
         category,

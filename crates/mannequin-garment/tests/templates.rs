@@ -30,15 +30,25 @@ fn assert_manifold(name: &str, mesh: &TriMesh) {
     }
 }
 
+/// Pants XL among them: eased out along the body's normals their inner legs crossed each other
+/// between the thighs (25 pairs), and a crossed template cannot be simulated with its contacts.
 #[test]
 fn every_close_fitting_category_is_a_clean_eased_manifold_that_transfers_to_its_own_body() {
+    let model = BodyModel::default_body();
+    let body = model.template_mesh();
     for (category, openings, size) in [
         (Category::Pants, 3, "M"),
+        (Category::Pants, 3, "XL"),
         (Category::ShortPants, 3, "XL"),
         (Category::Tshirt, 4, "XL"),
         (Category::Shirt, 4, "S"),
     ] {
-        check_template(category, openings, size, f32::NEG_INFINITY);
+        let g = check_template(category, openings, size, f32::NEG_INFINITY);
+        let name = format!("{} {size}", category.name());
+        let inside = vertices_inside_body(&g.mesh.positions, &body.positions, &body.faces);
+        assert_eq!(inside, 0, "{name}: {inside} vertices inside the body");
+        let crossing = self_intersecting_pairs(&g.mesh.positions, &g.mesh.faces);
+        assert_eq!(crossing, 0, "{name}: {crossing} pairs of its triangles cross");
     }
 }
 
