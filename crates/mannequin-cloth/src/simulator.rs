@@ -299,10 +299,7 @@ fn check_uncrossed(positions: &[[f32; 3]], faces: &[[u32; 3]], cloth_faces: usiz
         .collect();
     let (itself, layers): (Vec<[usize; 2]>, _) =
         crossed.into_iter().partition(|&[_, second]| second < cloth_faces);
-    let place = |[first, second]: [usize; 2]| {
-        let corners = faces[first].iter().chain(&faces[second]).map(|&v| Vec3::from(positions[v as usize]));
-        (corners.sum::<Vec3>() / 6.0).to_array()
-    };
+    let place = |pair| crate::quality::pair_place(positions, faces, pair);
     if let Some(&pair) = itself.first() {
         let [x, y, z] = place(pair);
         let [first, second] = pair;

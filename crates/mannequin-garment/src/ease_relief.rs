@@ -7,7 +7,7 @@
 //! neighbours unfolds it, as layering uncrosses its growth.
 
 use glam::Vec3;
-use mannequin_cloth::quality::self_intersections;
+use mannequin_cloth::quality::{pair_place, self_intersections};
 use mannequin_mesh::adjacency::one_rings;
 
 use crate::error::GarmentError;
@@ -42,7 +42,7 @@ pub(crate) fn smooth_out_crossings(
             front = next;
         }
         let smoothed: Vec<(usize, Vec3)> = (0..positions.len())
-            .filter(|&v| marked[v] && !rings[v].is_empty())
+            .filter(|&v| marked[v])
             .map(|v| {
                 let sum = rings[v].iter().map(|&w| Vec3::from(positions[w as usize])).sum::<Vec3>();
                 (v, sum / rings[v].len() as f32)
@@ -63,18 +63,17 @@ pub(crate) fn check_uncrossed(
     when: &str,
 ) -> Result<(), GarmentError> {
     let crossed = self_intersections(positions, faces);
-    let Some(&[a, b]) = crossed.first() else { return Ok(()) };
-    let corners = faces[a].iter().chain(&faces[b]).map(|&v| Vec3::from(positions[v as usize]));
-    let place = corners.sum::<Vec3>() / 6.0;
+    let Some(&pair) = crossed.first() else { return Ok(()) };
+    let [x, y, z] = pair_place(positions, faces, pair);
     Err(GarmentError::invalid(
         "fit",
         format!(
             "the eased garment crosses itself {when}: pairs of triangles crossing: {}, the \
              first near ({:.3}, {:.3}, {:.3}) m (a smaller ease there may clear it)",
             crossed.len(),
-            place.x,
-            place.y,
-            place.z
+            x,
+            y,
+            z
         ),
     ))
 }

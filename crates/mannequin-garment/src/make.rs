@@ -25,8 +25,8 @@ pub const TEMPLATE_REVISION: u32 = 5;
 
 /// Remeshing rounds: Botsch & Kobbelt find 5–10 enough; the body's 5 cm edges need the upper end.
 const REMESH_ROUNDS: usize = 10;
-/// Rounds after a panel is sewn on or a front cut open, where only the seam, the cut and the
-/// folds need them.
+/// Rounds after a panel is sewn on, a front cut open or crossings smoothed out, where only the
+/// seam, the cut, the folds and the smoothed patch need them.
 const SEWN_REMESH_ROUNDS: usize = 3;
 
 /// The template of `category` cut to `fit`, remeshed to `edge_length`, on `model` (named
@@ -81,19 +81,11 @@ pub fn make_garment(
         // The coat opens down the front, through bodice and skirt at once.
         let cut = if category == Category::LongCoat { open_front(&sewn, &marks) } else { sewn.clone() };
         // Even out the triangles the seam, the folds and the cut left, on the draped surface.
-        let surface = ClosestPoint::new(&sewn.positions, &sewn.faces, 0.03);
-        let (positions, faces) = remesh(&cut.positions, &cut.faces, edge_length, SEWN_REMESH_ROUNDS, |p| {
-            surface.query(p).map_or(p, |(_, q)| q)
-        });
-        mesh = TriMesh::new(positions, faces);
+        mesh = evened(&cut, &sewn, edge_length);
     }
     if smooth_out_crossings(&mut mesh.positions, &mesh.faces)? {
         // Even out the triangles the smoothing squeezed, on the smoothed surface.
-        let smoothed = ClosestPoint::new(&mesh.positions, &mesh.faces, 0.03);
-        let (positions, faces) = remesh(&mesh.positions, &mesh.faces, edge_length, SEWN_REMESH_ROUNDS, |p| {
-            smoothed.query(p).map_or(p, |(_, q)| q)
-        });
-        mesh = TriMesh::new(positions, faces);
+        mesh = evened(&mesh, &mesh, edge_length);
         check_uncrossed(&mesh.positions, &mesh.faces, "after smoothing and remeshing")?;
     }
     let recipe = Recipe {
@@ -111,6 +103,16 @@ pub fn make_garment(
     let garment = Garment::bind(recipe, mesh.clone(), &surface);
     mesh.uv = body.uv.as_ref().map(|uv| carried_uvs(&garment, &rest, &body.faces, uv));
     Ok(Garment { mesh, ..garment })
+}
+
+/// `mesh` after [`SEWN_REMESH_ROUNDS`] rounds of remeshing to `edge_length` on the surface of
+/// `on`: where a step (a seam, a cut, a smoothing) left its triangles uneven.
+fn evened(mesh: &TriMesh, on: &TriMesh, edge_length: f32) -> TriMesh {
+    let surface = ClosestPoint::new(&on.positions, &on.faces, 0.03);
+    let (positions, faces) = remesh(&mesh.positions, &mesh.faces, edge_length, SEWN_REMESH_ROUNDS, |p| {
+        surface.query(p).map_or(p, |(_, q)| q)
+    });
+    TriMesh::new(positions, faces)
 }
 
 /// Per-corner UVs from the body's layout: each garment face takes the chart of the body face

@@ -9,7 +9,7 @@ mod separating_axis;
 mod strain;
 mod triangle_intersection;
 
-pub use self_intersection::{crossing_pairs, self_intersecting_pairs, self_intersections};
+pub use self_intersection::{crossing_pairs, pair_place, self_intersecting_pairs, self_intersections};
 pub use strain::{edge_strain, stretch_quantile};
 
 /// How many cloth vertices lie inside the closed body mesh (`body_positions`, `body_faces`).

@@ -19,6 +19,14 @@ pub fn self_intersecting_pairs(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> us
     self_intersections(positions, faces).len()
 }
 
+/// Where the pair of `faces` `[first, second]` lies, the mean of its six corners: the place an
+/// error about a crossing names.
+pub fn pair_place(positions: &[[f32; 3]], faces: &[[u32; 3]], [first, second]: [usize; 2]) -> [f32; 3] {
+    let corners = faces[first].iter().chain(&faces[second]).map(|&v| positions[v as usize]);
+    let sum = corners.fold([0.0; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
+    sum.map(|c| c / 6.0)
+}
+
 /// The intersecting pairs of triangles with no vertex in common, as face indices (i < j), in
 /// ascending order: where a mesh crosses itself.
 pub fn self_intersections(positions: &[[f32; 3]], faces: &[[u32; 3]]) -> Vec<[usize; 2]> {
